@@ -1,0 +1,65 @@
+# Carom: the two commands of the README, and the pieces they are made of.
+#   make demo   build and run a real example
+#   make test   every check CI runs (fmt, clippy, cargo test f32 + f64, Python package + pytest)
+# Everything Python lives in a local venv (.venv) that these targets create.
+
+SHELL := /bin/bash
+VENV ?= .venv
+PYTHON ?= python3
+PY := $(VENV)/bin/python
+CARGO ?= cargo
+export CARGO_TERM_COLOR ?= never
+
+.PHONY: demo test fmt fmt-check lint rust-test rust-test-f64 python-test develop venv bench toolchain clean
+
+toolchain:
+	@command -v $(CARGO) >/dev/null || { echo "error: cargo not found; install Rust (rustup) first"; exit 1; }
+	@command -v $(PYTHON) >/dev/null || { echo "error: $(PYTHON) not found"; exit 1; }
+	@$(CARGO) fmt --version >/dev/null 2>&1 || rustup component add rustfmt
+	@$(CARGO) clippy --version >/dev/null 2>&1 || rustup component add clippy
+
+venv: $(VENV)/.ready
+
+$(VENV)/.ready: python/requirements-dev.txt
+	$(PYTHON) -m venv $(VENV)
+	$(PY) -m pip install --quiet --upgrade pip
+	$(PY) -m pip install --quiet -r python/requirements-dev.txt
+	touch $@
+
+# Build the extension in release mode and install the package into the venv.
+develop: toolchain venv
+	VIRTUAL_ENV=$(abspath $(VENV)) PATH=$(abspath $(VENV))/bin:$$PATH \
+		$(VENV)/bin/maturin develop --release --quiet
+
+demo: toolchain develop
+	$(CARGO) run --release -p carom-bench --bin carom-demo
+	$(PY) examples/demo.py
+
+fmt:
+	$(CARGO) fmt --all
+
+fmt-check: toolchain
+	$(CARGO) fmt --all -- --check
+
+lint: toolchain
+	$(CARGO) clippy --workspace --all-targets -- -D warnings
+	$(CARGO) clippy --workspace --all-targets --features carom-collision/f64 -- -D warnings
+
+rust-test: toolchain
+	$(CARGO) test --workspace
+
+rust-test-f64: toolchain
+	$(CARGO) test --workspace --features carom-collision/f64
+
+python-test: develop
+	$(PY) -m pytest -q python/tests
+
+test: fmt-check lint rust-test rust-test-f64 python-test
+	@echo "make test: all checks passed"
+
+bench: toolchain
+	$(CARGO) run --release -p carom-bench --bin carom-bench -- all
+
+clean:
+	$(CARGO) clean
+	rm -rf $(VENV)

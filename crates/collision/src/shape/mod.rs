@@ -1,0 +1,359 @@
+//! Collision shapes: one file per shape, a closed [`Shape`] enum, support maps and mass
+//! properties.
+//!
+//! Shapes are immutable and shared behind `Arc`. Convex shapes implement [`SupportMap`];
+//! [`Shape::as_convex`] gives a [`ConvexRef`] that dispatches by `match`, without vtables.
+//! Capsules, cylinders and cones lie along the local **Y** axis.
+
+mod capsule;
+mod compound;
+mod cone;
+mod convex_hull;
+mod cuboid;
+mod cylinder;
+mod mass;
+mod plane;
+mod quickhull;
+mod scaled;
+mod sphere;
+mod support;
+mod triangle;
+mod trimesh;
+
+pub use capsule::Capsule;
+pub use compound::Compound;
+pub use cone::Cone;
+pub use convex_hull::{ConvexHull, HullFace};
+pub use cuboid::{Cuboid, DEFAULT_MARGIN};
+pub use cylinder::Cylinder;
+pub use mass::{polyhedron_mass_properties, MassProperties};
+pub use plane::Plane;
+pub use quickhull::{quickhull, HullPolygons};
+pub use scaled::Scaled;
+pub use sphere::Sphere;
+pub use support::SupportMap;
+pub use triangle::Triangle;
+pub use trimesh::TriMesh;
+
+use crate::error::{CaromError, Result};
+use crate::math::{check_positive, Aabb, Isometry, Real, Vec3};
+use serde::{Deserialize, Serialize};
+use std::sync::Arc;
+
+/// Every shape Carom knows, as a closed enum so shape-pair dispatch is an exhaustive `match`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub enum Shape {
+    /// A sphere.
+    Sphere(Sphere),
+    /// A box (`carom.Box` in Python).
+    Cuboid(Cuboid),
+    /// A capsule along Y.
+    Capsule(Capsule),
+    /// A cylinder along Y.
+    Cylinder(Cylinder),
+    /// A cone along Y.
+    Cone(Cone),
+    /// A convex hull of points.
+    ConvexHull(ConvexHull),
+    /// A single triangle.
+    Triangle(Triangle),
+    /// An infinite plane (static bodies only).
+    Plane(Plane),
+    /// A triangle mesh.
+    TriMesh(TriMesh),
+    /// Children at local poses.
+    Compound(Compound),
+    /// A non-uniformly scaled convex shape.
+    Scaled(Scaled),
+}
+
+/// The kind of a [`Shape`], without its data.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+pub enum ShapeKind {
+    /// [`Sphere`]
+    Sphere,
+    /// [`Cuboid`]
+    Cuboid,
+    /// [`Capsule`]
+    Capsule,
+    /// [`Cylinder`]
+    Cylinder,
+    /// [`Cone`]
+    Cone,
+    /// [`ConvexHull`]
+    ConvexHull,
+    /// [`Triangle`]
+    Triangle,
+    /// [`Plane`]
+    Plane,
+    /// [`TriMesh`]
+    TriMesh,
+    /// [`Compound`]
+    Compound,
+    /// [`Scaled`]
+    Scaled,
+}
+
+/// A borrowed convex shape: the subset of [`Shape`] with a support map.
+#[derive(Debug, Clone, Copy)]
+pub enum ConvexRef<'a> {
+    /// A sphere.
+    Sphere(&'a Sphere),
+    /// A box.
+    Cuboid(&'a Cuboid),
+    /// A capsule.
+    Capsule(&'a Capsule),
+    /// A cylinder.
+    Cylinder(&'a Cylinder),
+    /// A cone.
+    Cone(&'a Cone),
+    /// A convex hull.
+    ConvexHull(&'a ConvexHull),
+    /// A triangle.
+    Triangle(&'a Triangle),
+    /// A scaled convex shape.
+    Scaled(&'a Scaled),
+}
+
+macro_rules! convex_dispatch {
+    ($self:expr, $s:ident => $e:expr) => {
+        match $self {
+            ConvexRef::Sphere($s) => $e,
+            ConvexRef::Cuboid($s) => $e,
+            ConvexRef::Capsule($s) => $e,
+            ConvexRef::Cylinder($s) => $e,
+            ConvexRef::Cone($s) => $e,
+            ConvexRef::ConvexHull($s) => $e,
+            ConvexRef::Triangle($s) => $e,
+            ConvexRef::Scaled($s) => $e,
+        }
+    };
+}
+
+impl SupportMap for ConvexRef<'_> {
+    #[inline]
+    fn support(&self, dir: Vec3) -> Vec3 {
+        convex_dispatch!(self, s => s.support(dir))
+    }
+    #[inline]
+    fn support_core(&self, dir: Vec3) -> Vec3 {
+        convex_dispatch!(self, s => s.support_core(dir))
+    }
+    #[inline]
+    fn margin(&self) -> Real {
+        convex_dispatch!(self, s => s.margin())
+    }
+}
+
+impl<'a> ConvexRef<'a> {
+    /// The kind of the referenced shape.
+    pub fn kind(&self) -> ShapeKind {
+        match self {
+            ConvexRef::Sphere(_) => ShapeKind::Sphere,
+            ConvexRef::Cuboid(_) => ShapeKind::Cuboid,
+            ConvexRef::Capsule(_) => ShapeKind::Capsule,
+            ConvexRef::Cylinder(_) => ShapeKind::Cylinder,
+            ConvexRef::Cone(_) => ShapeKind::Cone,
+            ConvexRef::ConvexHull(_) => ShapeKind::ConvexHull,
+            ConvexRef::Triangle(_) => ShapeKind::Triangle,
+            ConvexRef::Scaled(_) => ShapeKind::Scaled,
+        }
+    }
+
+    /// Local bounding box.
+    pub fn local_aabb(&self) -> Aabb {
+        convex_dispatch!(self, s => s.local_aabb())
+    }
+}
+
+macro_rules! shape_dispatch {
+    ($self:expr, $s:ident => $e:expr) => {
+        match $self {
+            Shape::Sphere($s) => $e,
+            Shape::Cuboid($s) => $e,
+            Shape::Capsule($s) => $e,
+            Shape::Cylinder($s) => $e,
+            Shape::Cone($s) => $e,
+            Shape::ConvexHull($s) => $e,
+            Shape::Triangle($s) => $e,
+            Shape::Plane($s) => $e,
+            Shape::TriMesh($s) => $e,
+            Shape::Compound($s) => $e,
+            Shape::Scaled($s) => $e,
+        }
+    };
+}
+
+impl Shape {
+    /// The shape's kind.
+    pub fn kind(&self) -> ShapeKind {
+        match self {
+            Shape::Sphere(_) => ShapeKind::Sphere,
+            Shape::Cuboid(_) => ShapeKind::Cuboid,
+            Shape::Capsule(_) => ShapeKind::Capsule,
+            Shape::Cylinder(_) => ShapeKind::Cylinder,
+            Shape::Cone(_) => ShapeKind::Cone,
+            Shape::ConvexHull(_) => ShapeKind::ConvexHull,
+            Shape::Triangle(_) => ShapeKind::Triangle,
+            Shape::Plane(_) => ShapeKind::Plane,
+            Shape::TriMesh(_) => ShapeKind::TriMesh,
+            Shape::Compound(_) => ShapeKind::Compound,
+            Shape::Scaled(_) => ShapeKind::Scaled,
+        }
+    }
+
+    /// A lower-case name of the kind, for messages.
+    pub fn kind_name(&self) -> &'static str {
+        match self.kind() {
+            ShapeKind::Sphere => "sphere",
+            ShapeKind::Cuboid => "box",
+            ShapeKind::Capsule => "capsule",
+            ShapeKind::Cylinder => "cylinder",
+            ShapeKind::Cone => "cone",
+            ShapeKind::ConvexHull => "convex hull",
+            ShapeKind::Triangle => "triangle",
+            ShapeKind::Plane => "plane",
+            ShapeKind::TriMesh => "triangle mesh",
+            ShapeKind::Compound => "compound",
+            ShapeKind::Scaled => "scaled shape",
+        }
+    }
+
+    /// The convex view of the shape, or `None` for planes, meshes and compounds.
+    #[inline]
+    pub fn as_convex(&self) -> Option<ConvexRef<'_>> {
+        Some(match self {
+            Shape::Sphere(s) => ConvexRef::Sphere(s),
+            Shape::Cuboid(s) => ConvexRef::Cuboid(s),
+            Shape::Capsule(s) => ConvexRef::Capsule(s),
+            Shape::Cylinder(s) => ConvexRef::Cylinder(s),
+            Shape::Cone(s) => ConvexRef::Cone(s),
+            Shape::ConvexHull(s) => ConvexRef::ConvexHull(s),
+            Shape::Triangle(s) => ConvexRef::Triangle(s),
+            Shape::Scaled(s) => ConvexRef::Scaled(s),
+            Shape::Plane(_) | Shape::TriMesh(_) | Shape::Compound(_) => return None,
+        })
+    }
+
+    /// True for shapes with a support map.
+    pub fn is_convex(&self) -> bool {
+        self.as_convex().is_some()
+    }
+
+    /// Bounding box in the shape's local frame.
+    pub fn local_aabb(&self) -> Aabb {
+        shape_dispatch!(self, s => s.local_aabb())
+    }
+
+    /// Tight world bounding box of the shape placed at `pose`. Exact for convex shapes (six
+    /// support queries along the world axes); for meshes and compounds, the children's boxes.
+    pub fn aabb(&self, pose: &Isometry) -> Aabb {
+        match self {
+            Shape::Sphere(s) => {
+                Aabb::from_center_half_extents(pose.translation, Vec3::splat(s.radius()))
+            }
+            Shape::Cuboid(s) => s.local_aabb().transformed(pose),
+            Shape::Plane(p) => {
+                let n = pose.transform_vector(p.normal());
+                let offset = p.offset() + n.dot(pose.translation);
+                match Plane::new(n, offset) {
+                    Ok(plane) => plane.local_aabb(),
+                    Err(_) => Aabb::new(
+                        Vec3::splat(-crate::math::UNBOUNDED),
+                        Vec3::splat(crate::math::UNBOUNDED),
+                    ),
+                }
+            }
+            Shape::TriMesh(m) => {
+                Aabb::from_points(m.vertices().iter().map(|v| pose.transform_point(*v)))
+            }
+            Shape::Compound(c) => c
+                .children()
+                .iter()
+                .fold(Aabb::EMPTY, |acc, (child_pose, s)| {
+                    acc.merge(&s.aabb(&pose.mul(child_pose)))
+                }),
+            _ => {
+                let convex = self.as_convex().expect("remaining variants are convex");
+                let mut min = Vec3::ZERO;
+                let mut max = Vec3::ZERO;
+                for i in 0..3 {
+                    let mut axis = Vec3::ZERO;
+                    axis[i] = 1.0;
+                    max[i] = convex.support_world(pose, axis)[i];
+                    min[i] = convex.support_world(pose, -axis)[i];
+                }
+                Aabb::new(min, max)
+            }
+        }
+    }
+
+    /// Volume (0 for triangles, planes and open meshes).
+    pub fn volume(&self) -> Real {
+        match self {
+            Shape::Triangle(_) | Shape::Plane(_) => 0.0,
+            Shape::Sphere(s) => s.volume(),
+            Shape::Cuboid(s) => s.volume(),
+            Shape::Capsule(s) => s.volume(),
+            Shape::Cylinder(s) => s.volume(),
+            Shape::Cone(s) => s.volume(),
+            Shape::ConvexHull(s) => s.volume(),
+            Shape::TriMesh(s) => s.volume(),
+            Shape::Compound(s) => s.volume(),
+            Shape::Scaled(s) => s.volume(),
+        }
+    }
+
+    /// Mass properties for a uniform density (zero mass for triangles and planes).
+    pub fn mass_properties(&self, density: Real) -> MassProperties {
+        match self {
+            Shape::Triangle(_) | Shape::Plane(_) => MassProperties::ZERO,
+            Shape::Sphere(s) => s.mass_properties(density),
+            Shape::Cuboid(s) => s.mass_properties(density),
+            Shape::Capsule(s) => s.mass_properties(density),
+            Shape::Cylinder(s) => s.mass_properties(density),
+            Shape::Cone(s) => s.mass_properties(density),
+            Shape::ConvexHull(s) => s.mass_properties(density),
+            Shape::TriMesh(s) => s.mass_properties(density),
+            Shape::Compound(s) => s.mass_properties(density),
+            Shape::Scaled(s) => s.mass_properties(density),
+        }
+    }
+
+    /// Mass properties after checking `density` (finite, > 0).
+    pub fn checked_mass_properties(&self, density: Real) -> Result<MassProperties> {
+        check_positive("density", density)?;
+        Ok(self.mass_properties(density))
+    }
+
+    /// This shape scaled by `scale` (convex shapes only).
+    pub fn scaled(self: &Arc<Self>, scale: Vec3) -> Result<Shape> {
+        Ok(Shape::Scaled(Scaled::new(self.clone(), scale)?))
+    }
+
+    /// Collision margin of a convex shape (`None` for others).
+    pub fn margin(&self) -> Option<Real> {
+        self.as_convex().map(|c| c.margin())
+    }
+
+    /// Returns an error unless the shape is convex.
+    pub fn require_convex(&self, what: &str) -> Result<ConvexRef<'_>> {
+        self.as_convex().ok_or_else(|| {
+            CaromError::Unsupported(format!(
+                "{what} needs a convex shape, not a {}",
+                self.kind_name()
+            ))
+        })
+    }
+}
+
+macro_rules! impl_from {
+    ($($t:ident => $v:ident),*) => {$(
+        impl From<$t> for Shape {
+            fn from(s: $t) -> Shape { Shape::$v(s) }
+        }
+    )*};
+}
+impl_from!(Sphere => Sphere, Cuboid => Cuboid, Capsule => Capsule, Cylinder => Cylinder,
+    Cone => Cone, ConvexHull => ConvexHull, Triangle => Triangle, Plane => Plane,
+    TriMesh => TriMesh, Compound => Compound, Scaled => Scaled);

@@ -1,0 +1,2 @@
+//! Shared scenes.
+#![warn(missing_docs)]
