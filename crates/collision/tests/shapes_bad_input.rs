@@ -68,8 +68,13 @@ fn hulls_reject_degenerate_clouds() {
     assert_names(ConvexHull::new(&[Vec3::ZERO, Vec3::X, Vec3::Y]), "points");
     assert!(ConvexHull::new(&[]).is_err());
     // Coplanar and collinear clouds have no 3D hull.
-    let flat: Vec<Vec3> = (0..20).map(|i| Vec3::new(i as Real, (i * i % 7) as Real, 0.0)).collect();
-    assert!(matches!(ConvexHull::new(&flat), Err(CaromError::Degenerate { .. })));
+    let flat: Vec<Vec3> = (0..20)
+        .map(|i| Vec3::new(i as Real, (i * i % 7) as Real, 0.0))
+        .collect();
+    assert!(matches!(
+        ConvexHull::new(&flat),
+        Err(CaromError::Degenerate { .. })
+    ));
     let line: Vec<Vec3> = (0..10).map(|i| Vec3::splat(i as Real)).collect();
     assert!(ConvexHull::new(&line).is_err());
     let dup = vec![Vec3::ONE; 10];
@@ -85,22 +90,48 @@ fn meshes_compounds_and_scaling() {
     assert_names(TriMesh::new(v.clone(), vec![[0, 1, 3]]), "indices[0][2]");
     assert_names(TriMesh::new(v.clone(), vec![]), "indices");
     assert_names(TriMesh::new(vec![], vec![[0, 0, 0]]), "vertices");
-    assert_names(TriMesh::new(vec![Vec3::ZERO, Vec3::X, Vec3::splat(Real::INFINITY)], vec![[0, 1, 2]]), "vertices[2]");
-    assert!(TriMesh::new(v, vec![[0, 1, 2], [0, 0, 0]]).is_ok(), "degenerate triangles are kept");
+    assert_names(
+        TriMesh::new(
+            vec![Vec3::ZERO, Vec3::X, Vec3::splat(Real::INFINITY)],
+            vec![[0, 1, 2]],
+        ),
+        "vertices[2]",
+    );
+    assert!(
+        TriMesh::new(v, vec![[0, 1, 2], [0, 0, 0]]).is_ok(),
+        "degenerate triangles are kept"
+    );
 
     assert_names(Compound::new(vec![]), "children");
     let plane = Arc::new(Shape::from(Plane::new(Vec3::Y, 0.0).unwrap()));
-    assert!(matches!(Compound::new(vec![(Isometry::IDENTITY, plane.clone())]), Err(CaromError::Unsupported(_))));
+    assert!(matches!(
+        Compound::new(vec![(Isometry::IDENTITY, plane.clone())]),
+        Err(CaromError::Unsupported(_))
+    ));
     let sphere = Arc::new(Shape::from(Sphere::new(1.0).unwrap()));
     let bad_pose = Isometry::new(Vec3::ZERO, Quat::from_xyzw(1.0, 1.0, 0.0, 0.0));
-    assert_names(Compound::new(vec![(bad_pose, sphere.clone())]), "children[0].pose");
+    assert_names(
+        Compound::new(vec![(bad_pose, sphere.clone())]),
+        "children[0].pose",
+    );
 
-    assert_names(Scaled::new(sphere.clone(), Vec3::new(1.0, 0.0, 1.0)), "scale");
-    assert_names(Scaled::new(sphere.clone(), Vec3::new(1.0, Real::NAN, 1.0)), "scale");
-    assert!(matches!(Scaled::new(plane, Vec3::ONE), Err(CaromError::Unsupported(_))));
+    assert_names(
+        Scaled::new(sphere.clone(), Vec3::new(1.0, 0.0, 1.0)),
+        "scale",
+    );
+    assert_names(
+        Scaled::new(sphere.clone(), Vec3::new(1.0, Real::NAN, 1.0)),
+        "scale",
+    );
+    assert!(matches!(
+        Scaled::new(plane, Vec3::ONE),
+        Err(CaromError::Unsupported(_))
+    ));
     // Scaling a scaled shape multiplies the factors.
     let once = Arc::new(Shape::from(Scaled::new(sphere, Vec3::splat(2.0)).unwrap()));
-    let Shape::Scaled(twice) = once.scaled(Vec3::new(1.0, 3.0, 1.0)).unwrap() else { panic!() };
+    let Shape::Scaled(twice) = once.scaled(Vec3::new(1.0, 3.0, 1.0)).unwrap() else {
+        panic!()
+    };
     assert_eq!(twice.scale(), Vec3::new(2.0, 6.0, 2.0));
     assert!(matches!(**twice.inner(), Shape::Sphere(_)));
 }

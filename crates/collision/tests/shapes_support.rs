@@ -1,6 +1,7 @@
 //! Support maps, bounding boxes and mass properties of every convex shape, checked against
 //! independent oracles: dense surface samples, implicit inside tests and Monte Carlo
 //! integration.
+#![allow(clippy::needless_range_loop)]
 
 mod common;
 
@@ -22,15 +23,25 @@ fn test_shapes() -> Vec<Shape> {
         Cylinder::new(0.6, 0.4).unwrap().into(),
         Cone::new(0.5, 1.2).unwrap().into(),
         ConvexHull::new(&taru).unwrap().into(),
-        Triangle::new(Vec3::new(0.0, 0.0, 0.0), Vec3::new(1.0, 0.2, 0.0), Vec3::new(0.3, 1.0, 0.5))
-            .unwrap()
-            .into(),
-        Scaled::new(Arc::new(Capsule::new(0.5, 1.0).unwrap().into()), Vec3::new(2.0, 0.5, -1.0))
-            .unwrap()
-            .into(),
-        Scaled::new(Arc::new(Cone::new(0.5, 1.0).unwrap().into()), Vec3::new(1.0, 3.0, 0.25))
-            .unwrap()
-            .into(),
+        Triangle::new(
+            Vec3::new(0.0, 0.0, 0.0),
+            Vec3::new(1.0, 0.2, 0.0),
+            Vec3::new(0.3, 1.0, 0.5),
+        )
+        .unwrap()
+        .into(),
+        Scaled::new(
+            Arc::new(Capsule::new(0.5, 1.0).unwrap().into()),
+            Vec3::new(2.0, 0.5, -1.0),
+        )
+        .unwrap()
+        .into(),
+        Scaled::new(
+            Arc::new(Cone::new(0.5, 1.0).unwrap().into()),
+            Vec3::new(1.0, 3.0, 0.25),
+        )
+        .unwrap()
+        .into(),
     ]
 }
 
@@ -48,7 +59,9 @@ fn pose() -> impl Strategy<Value = Isometry> {
         unit_dir(),
         -3.2..3.2 as Real,
     )
-        .prop_map(|(x, y, z, axis, angle)| Isometry::new(Vec3::new(x, y, z), Quat::from_axis_angle(axis, angle)))
+        .prop_map(|(x, y, z, axis, angle)| {
+            Isometry::new(Vec3::new(x, y, z), Quat::from_axis_angle(axis, angle))
+        })
 }
 
 proptest! {
@@ -142,7 +155,11 @@ fn monte_carlo(shape: &Shape, n: usize, rng: &mut Rng) -> (f64, [f64; 3], [[f64;
 #[test]
 fn mass_properties_match_monte_carlo_integration() {
     let mut rng = Rng::new(7);
-    let n = if cfg!(debug_assertions) { 200_000 } else { 1_000_000 };
+    let n = if cfg!(debug_assertions) {
+        200_000
+    } else {
+        1_000_000
+    };
     for shape in test_shapes() {
         if matches!(shape, Shape::Triangle(_)) {
             continue;
@@ -152,17 +169,31 @@ fn mass_properties_match_monte_carlo_integration() {
         let (vol, com, inertia) = monte_carlo(&shape, n, &mut rng);
         let size = shape.local_aabb().extents().max_element() as f64;
         let name = shape.kind_name();
-        assert!(((shape.volume() as f64) - vol).abs() < 0.02 * vol, "{name}: volume {} vs {vol}", shape.volume());
-        assert!(((mp.mass as f64) - density * vol).abs() < 0.02 * density * vol, "{name}: mass");
+        assert!(
+            ((shape.volume() as f64) - vol).abs() < 0.02 * vol,
+            "{name}: volume {} vs {vol}",
+            shape.volume()
+        );
+        assert!(
+            ((mp.mass as f64) - density * vol).abs() < 0.02 * density * vol,
+            "{name}: mass"
+        );
         for i in 0..3 {
-            assert!(((mp.center_of_mass[i] as f64) - com[i]).abs() < 0.01 * size, "{name}: com {:?} vs {com:?}", mp.center_of_mass);
+            assert!(
+                ((mp.center_of_mass[i] as f64) - com[i]).abs() < 0.01 * size,
+                "{name}: com {:?} vs {com:?}",
+                mp.center_of_mass
+            );
         }
         let scale = (0..3).map(|i| inertia[i][i]).fold(0.0, f64::max) * density;
         for i in 0..3 {
             for j in 0..3 {
                 let got = mp.inertia.col(j)[i] as f64;
                 let want = inertia[i][j] * density;
-                assert!((got - want).abs() < 0.04 * scale, "{name}: inertia[{i}][{j}] {got} vs {want}");
+                assert!(
+                    (got - want).abs() < 0.04 * scale,
+                    "{name}: inertia[{i}][{j}] {got} vs {want}"
+                );
             }
         }
     }
@@ -175,15 +206,26 @@ fn analytic_mass_properties() {
     let s = Sphere::new(2.0).unwrap().mass_properties(3.0);
     let m = 3.0 * 4.0 / 3.0 * PI * 8.0;
     assert!(close(s.mass, m) && close(s.inertia.x_axis.x, 0.4 * m * 4.0));
-    let b = Cuboid::new(Vec3::new(1.0, 2.0, 3.0)).unwrap().mass_properties(1.0);
+    let b = Cuboid::new(Vec3::new(1.0, 2.0, 3.0))
+        .unwrap()
+        .mass_properties(1.0);
     assert!(close(b.mass, 48.0) && close(b.inertia.x_axis.x, 48.0 * (16.0 + 36.0) / 12.0));
     let c = Cylinder::new(1.0, 2.0).unwrap().mass_properties(1.0);
     let m = PI * 4.0;
-    assert!(close(c.mass, m) && close(c.inertia.y_axis.y, 0.5 * m) && close(c.inertia.x_axis.x, m * (3.0 + 16.0) / 12.0));
+    assert!(
+        close(c.mass, m)
+            && close(c.inertia.y_axis.y, 0.5 * m)
+            && close(c.inertia.x_axis.x, m * (3.0 + 16.0) / 12.0)
+    );
     let k = Cone::new(1.0, 1.5).unwrap().mass_properties(1.0);
     let m = PI * 3.0 / 3.0;
-    assert!(close(k.mass, m) && close(k.center_of_mass.y, -0.75) && close(k.inertia.y_axis.y, 0.3 * m));
-    assert!(close(k.inertia.x_axis.x, m * (3.0 / 20.0 + 3.0 / 80.0 * 9.0)));
+    assert!(
+        close(k.mass, m) && close(k.center_of_mass.y, -0.75) && close(k.inertia.y_axis.y, 0.3 * m)
+    );
+    assert!(close(
+        k.inertia.x_axis.x,
+        m * (3.0 / 20.0 + 3.0 / 80.0 * 9.0)
+    ));
     // A capsule of zero height tends to a sphere; a long one to a cylinder plus a sphere.
     let cap = Capsule::new(1.0, 1e-3).unwrap().mass_properties(1.0);
     let sphere = Sphere::new(1.0).unwrap().mass_properties(1.0);
@@ -191,12 +233,17 @@ fn analytic_mass_properties() {
     // Compound of two unit boxes side by side equals one 2x1x1 box.
     let unit = Arc::new(Shape::from(Cuboid::new(Vec3::splat(0.5)).unwrap()));
     let comp = Compound::new(vec![
-        (Isometry::from_translation(Vec3::new(-0.5, 0.0, 0.0)), unit.clone()),
+        (
+            Isometry::from_translation(Vec3::new(-0.5, 0.0, 0.0)),
+            unit.clone(),
+        ),
         (Isometry::from_translation(Vec3::new(0.5, 0.0, 0.0)), unit),
     ])
     .unwrap()
     .mass_properties(1.0);
-    let whole = Cuboid::new(Vec3::new(1.0, 0.5, 0.5)).unwrap().mass_properties(1.0);
+    let whole = Cuboid::new(Vec3::new(1.0, 0.5, 0.5))
+        .unwrap()
+        .mass_properties(1.0);
     assert!(close(comp.mass, whole.mass as f64));
     for i in 0..3 {
         assert!((comp.inertia.col(i) - whole.inertia.col(i)).length() < 1e-4);
@@ -205,7 +252,10 @@ fn analytic_mass_properties() {
     let sc = Scaled::new(Arc::new(Sphere::new(1.0).unwrap().into()), Vec3::splat(2.0)).unwrap();
     let direct = Sphere::new(2.0).unwrap().mass_properties(1.0);
     let via = sc.mass_properties(1.0);
-    assert!((via.mass - direct.mass).abs() < 1e-3 && (via.inertia.x_axis.x - direct.inertia.x_axis.x).abs() < 1e-2);
+    assert!(
+        (via.mass - direct.mass).abs() < 1e-3
+            && (via.inertia.x_axis.x - direct.inertia.x_axis.x).abs() < 1e-2
+    );
 }
 
 #[test]
@@ -213,7 +263,11 @@ fn taru_hull_matches_reference() {
     let hull = ConvexHull::new(&common::taru_points()).unwrap();
     // shared/data/README.md: 24 hull vertices, 44 triangles, volume 24.3499 (qhull).
     assert_eq!(hull.vertices().len(), 24);
-    assert!((hull.volume() - 24.3499).abs() < 1e-3, "volume {}", hull.volume());
+    assert!(
+        (hull.volume() - 24.3499).abs() < 1e-3,
+        "volume {}",
+        hull.volume()
+    );
 }
 
 /// A closed surface of revolution about Y from a profile `(radius, y)` running from the
@@ -249,8 +303,16 @@ fn mass_properties_match_tessellations() {
     let check = |name: &str, mp: MassProperties, profile: Vec<(Real, Real)>| {
         let (v, t) = revolve(&profile, 256);
         let (_, poly) = polyhedron_mass_properties(&v, &t);
-        assert!((mp.mass - poly.mass).abs() < 2e-3 * mp.mass, "{name}: mass {} vs {}", mp.mass, poly.mass);
-        assert!((mp.center_of_mass - poly.center_of_mass).length() < 2e-3, "{name}: com");
+        assert!(
+            (mp.mass - poly.mass).abs() < 2e-3 * mp.mass,
+            "{name}: mass {} vs {}",
+            mp.mass,
+            poly.mass
+        );
+        assert!(
+            (mp.center_of_mass - poly.center_of_mass).length() < 2e-3,
+            "{name}: com"
+        );
         for i in 0..3 {
             let (a, b) = (mp.inertia.col(i)[i], poly.inertia.col(i)[i]);
             assert!((a - b).abs() < 3e-3 * a, "{name}: inertia[{i}] {a} vs {b}");
@@ -267,17 +329,29 @@ fn mass_properties_match_tessellations() {
         profile.push((r * a.cos(), h + r * a.sin()));
     }
     profile.push((0.0, h + r));
-    check("capsule", Capsule::new(r, h).unwrap().mass_properties(1.0), profile);
+    check(
+        "capsule",
+        Capsule::new(r, h).unwrap().mass_properties(1.0),
+        profile,
+    );
     check(
         "cylinder",
         Cylinder::new(0.6, 0.4).unwrap().mass_properties(1.0),
         vec![(0.0, -0.4), (0.6, -0.4), (0.6, 0.4), (0.0, 0.4)],
     );
-    check("cone", Cone::new(0.5, 1.2).unwrap().mass_properties(1.0), vec![(0.0, -1.2), (0.5, -1.2), (0.0, 1.2)]);
+    check(
+        "cone",
+        Cone::new(0.5, 1.2).unwrap().mass_properties(1.0),
+        vec![(0.0, -1.2), (0.5, -1.2), (0.0, 1.2)],
+    );
     let mut sphere = vec![];
     for i in 0..=2 * n {
         let a = -PI / 2.0 + PI * i as Real / (2 * n) as Real;
         sphere.push((0.7 * a.cos(), 0.7 * a.sin()));
     }
-    check("sphere", Sphere::new(0.7).unwrap().mass_properties(1.0), sphere);
+    check(
+        "sphere",
+        Sphere::new(0.7).unwrap().mass_properties(1.0),
+        sphere,
+    );
 }

@@ -31,12 +31,14 @@ pub fn quickhull(points: &[Vec3]) -> Result<HullPolygons> {
         .max(1e-30);
     let eps = scale * 1e-5;
     let n = points.len();
-    let mut planes: Vec<(Vec3, Real)> = Vec::new();
+    // (normal, offset, area of the defining triple): the largest triple defines the plane best.
+    let mut planes: Vec<(Vec3, Real, Real)> = Vec::new();
     for i in 0..n {
         for j in i + 1..n {
             for k in j + 1..n {
                 let (a, b, c) = (points[i], points[j], points[k]);
-                let Some(nrm) = (b - a).cross(c - a).try_normalize() else {
+                let cross = (b - a).cross(c - a);
+                let Some(nrm) = cross.try_normalize() else {
                     continue;
                 };
                 let d = nrm.dot(a);
@@ -52,11 +54,13 @@ pub fn quickhull(points: &[Vec3]) -> Result<HullPolygons> {
                     (true, false) => (-nrm, -d),
                     _ => continue,
                 };
-                if !planes
-                    .iter()
-                    .any(|(m, o)| (*m - plane.0).length() < 1e-4 && (o - plane.1).abs() < eps)
-                {
-                    planes.push(plane);
+                let area = cross.length();
+                match planes.iter_mut().find(|(m, o, _)| {
+                    (*m - plane.0).length() < 1e-3 && (*o - plane.1).abs() < 10.0 * eps
+                }) {
+                    Some(existing) if existing.2 < area => *existing = (plane.0, plane.1, area),
+                    Some(_) => {}
+                    None => planes.push((plane.0, plane.1, area)),
                 }
             }
         }
@@ -69,7 +73,7 @@ pub fn quickhull(points: &[Vec3]) -> Result<HullPolygons> {
     }
     let mut vertices: Vec<Vec3> = Vec::new();
     let mut faces = Vec::new();
-    for (nrm, d) in &planes {
+    for (nrm, d, _) in &planes {
         let on: Vec<Vec3> = points
             .iter()
             .copied()

@@ -39,7 +39,10 @@ pub fn taru_points() -> Vec<Vec3> {
         .lines()
         .filter_map(|l| l.strip_prefix("v "))
         .map(|l| {
-            let c: Vec<Real> = l.split_whitespace().map(|x| x.parse::<f64>().unwrap() as Real).collect();
+            let c: Vec<Real> = l
+                .split_whitespace()
+                .map(|x| x.parse::<f64>().unwrap() as Real)
+                .collect();
             Vec3::new(c[0], c[1], c[2])
         })
         .collect()
@@ -55,9 +58,17 @@ fn sample_one(shape: &Shape, rng: &mut Rng) -> Vec3 {
         Shape::Sphere(s) => rng.unit() * s.radius(),
         Shape::Cuboid(b) => {
             let h = b.half_extents();
-            let mut p = Vec3::new(rng.range(-h.x, h.x), rng.range(-h.y, h.y), rng.range(-h.z, h.z));
+            let mut p = Vec3::new(
+                rng.range(-h.x, h.x),
+                rng.range(-h.y, h.y),
+                rng.range(-h.z, h.z),
+            );
             let axis = (rng.uniform() * 3.0) as usize % 3;
-            p[axis] = if rng.uniform() < 0.5 { -h[axis] } else { h[axis] };
+            p[axis] = if rng.uniform() < 0.5 {
+                -h[axis]
+            } else {
+                h[axis]
+            };
             p
         }
         Shape::Capsule(c) => {
@@ -77,10 +88,18 @@ fn sample_one(shape: &Shape, rng: &mut Rng) -> Vec3 {
         Shape::Cylinder(c) => {
             let a = rng.range(0.0, 2.0 * PI);
             match (rng.uniform() * 3.0) as usize {
-                0 => Vec3::new(c.radius() * a.cos(), rng.range(-c.half_height(), c.half_height()), c.radius() * a.sin()),
+                0 => Vec3::new(
+                    c.radius() * a.cos(),
+                    rng.range(-c.half_height(), c.half_height()),
+                    c.radius() * a.sin(),
+                ),
                 k => {
                     let r = c.radius() * rng.uniform().sqrt();
-                    let y = if k == 1 { c.half_height() } else { -c.half_height() };
+                    let y = if k == 1 {
+                        c.half_height()
+                    } else {
+                        -c.half_height()
+                    };
                     Vec3::new(r * a.cos(), y, r * a.sin())
                 }
             }
@@ -127,12 +146,15 @@ pub fn inside(shape: &Shape, p: Vec3, tol: Real) -> bool {
             (p - Vec3::new(0.0, y, 0.0)).length() <= c.radius() + tol
         }
         Shape::Cylinder(c) => {
-            Vec3::new(p.x, 0.0, p.z).length() <= c.radius() + tol && p.y.abs() <= c.half_height() + tol
+            Vec3::new(p.x, 0.0, p.z).length() <= c.radius() + tol
+                && p.y.abs() <= c.half_height() + tol
         }
         Shape::Cone(c) => {
             let h = c.half_height();
             let frac = ((h - p.y) / (2.0 * h)).clamp(0.0, 1.0);
-            p.y >= -h - tol && p.y <= h + tol && Vec3::new(p.x, 0.0, p.z).length() <= c.radius() * frac + tol * 2.0
+            p.y >= -h - tol
+                && p.y <= h + tol
+                && Vec3::new(p.x, 0.0, p.z).length() <= c.radius() * frac + tol * 2.0
         }
         Shape::ConvexHull(h) => h.faces().iter().all(|f| f.normal.dot(p) - f.offset <= tol),
         Shape::Triangle(t) => {
@@ -147,7 +169,9 @@ pub fn inside(shape: &Shape, p: Vec3, tol: Real) -> bool {
                 return false;
             }
             let edges = [(t.a, t.b), (t.b, t.c), (t.c, t.a)];
-            edges.iter().all(|(u, v)| (*v - *u).cross(p - *u).dot(n) >= -tol * (*v - *u).length())
+            edges
+                .iter()
+                .all(|(u, v)| (*v - *u).cross(p - *u).dot(n) >= -tol * (*v - *u).length())
         }
         Shape::Scaled(s) => {
             let q = p / s.scale();
