@@ -85,7 +85,7 @@ pub fn to_real(name: &dyn Fn() -> String, x: f64) -> PyResult<Real> {
     let r = real(x);
     if x.is_finite() && (!r.is_finite() || (r == 0.0 && x != 0.0)) {
         return Err(invalid(format!(
-            "invalid {} = {x}: out of range for the {}-bit floating point precision of this build",
+            "invalid {} = {x:?}: out of range for the {}-bit floating point precision of this build",
             name(),
             std::mem::size_of::<Real>() * 8
         )));
