@@ -43,9 +43,13 @@ fn quat_mul(a: [f64; 4], b: [f64; 4]) -> [f64; 4] {
     ]
 }
 
+/// `q / |q|`, leaving quaternions already unit to within rounding untouched, so that
+/// validating a pose twice (e.g. `Pose.from_array(p.to_array())`) is exact.
 fn normalized(q: [f64; 4]) -> [f64; 4] {
     let len = q.iter().map(|x| x * x).sum::<f64>().sqrt();
-    if len > 0.0 {
+    if (len - 1.0).abs() <= 8.0 * f64::EPSILON {
+        q
+    } else if len > 0.0 {
         q.map(|x| x / len)
     } else {
         [0.0, 0.0, 0.0, 1.0]
