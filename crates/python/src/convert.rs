@@ -83,7 +83,7 @@ pub fn array_values(a: &Bound<'_, PyArrayDyn<f64>>) -> PyResult<(Vec<usize>, Vec
 /// precision is rejected (NaN and infinities pass through for the core to name).
 pub fn to_real(name: &dyn Fn() -> String, x: f64) -> PyResult<Real> {
     let r = real(x);
-    if x.is_finite() && (!r.is_finite() || (r == 0.0 && x != 0.0)) {
+    if !fits(x, r) {
         return Err(invalid(format!(
             "invalid {} = {x:?}: out of range for the {}-bit floating point precision of this build",
             name(),
@@ -91,6 +91,12 @@ pub fn to_real(name: &dyn Fn() -> String, x: f64) -> PyResult<Real> {
         )));
     }
     Ok(r)
+}
+
+/// True unless converting the finite `x` to `r` over- or underflowed.
+#[inline(always)]
+fn fits(x: f64, r: Real) -> bool {
+    !x.is_finite() || (r.is_finite() && (r != 0.0 || x == 0.0))
 }
 
 /// A scalar [`Real`] argument.
@@ -141,7 +147,12 @@ pub fn vec3s(
     }
     let mut out = Vec::with_capacity(values.len() / 3);
     for (i, c) in values.chunks_exact(3).enumerate() {
-        out.push(vec3_from(&format!("{name}[{i}]"), [c[0], c[1], c[2]])?);
+        let v = Vec3::new(real(c[0]), real(c[1]), real(c[2]));
+        if !(fits(c[0], v.x) && fits(c[1], v.y) && fits(c[2], v.z)) {
+            // Slow path, only to build the error naming the element.
+            vec3_from(&format!("{name}[{i}]"), [c[0], c[1], c[2]])?;
+        }
+        out.push(v);
     }
     Ok((out, single))
 }
