@@ -7,6 +7,8 @@ import math
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 import carom
 
@@ -297,3 +299,31 @@ def test_repr() -> None:
     # Parametric reprs evaluate back to an equal shape.
     for s in [carom.Sphere(0.1), carom.Box([0.5, 1, 2]), carom.Cylinder(0.3, 0.7), carom.Triangle([0, 0, 0], [1, 0, 0], [0, 1, 0])]:
         assert eval(repr(s), {**vars(carom)}) == s
+
+
+@settings(max_examples=200, deadline=None)
+@given(x=st.floats(allow_nan=True, allow_infinity=True, allow_subnormal=True))
+def test_any_float_radius_is_accepted_or_named(x: float) -> None:
+    try:
+        s = carom.Sphere(x)
+    except carom.CaromError as e:
+        assert "radius" in str(e)
+        assert not 1e-30 < x < 1e30
+        return
+    assert x > 0 and s.radius == pytest.approx(x, rel=1e-6)
+    assert s.volume == pytest.approx(4 / 3 * math.pi * s.radius**3, rel=1e-5) or math.isinf(s.volume)
+
+
+@settings(max_examples=100, deadline=None)
+@given(
+    v=st.lists(st.floats(allow_nan=True, allow_infinity=True), min_size=3, max_size=3),
+)
+def test_any_half_extents_are_accepted_or_named(v: list[float]) -> None:
+    try:
+        b = carom.Box(v)
+    except carom.CaromError as e:
+        assert "half_extents" in str(e)
+        assert not all(1e-30 < x < 1e30 for x in v)
+        return
+    assert all(x > 0 for x in v)
+    np.testing.assert_allclose(b.half_extents, v, rtol=1e-6)

@@ -164,7 +164,8 @@ impl PyCompound {
         Ok(init(core(|| Compound::new(parts))?.into(), PyCompound))
     }
 
-    /// The children as a list of `(shape, Pose)` pairs.
+    /// The children as a list of `(shape, Pose)` pairs (poses at the core's precision,
+    /// see `carom.REAL_BITS`).
     #[getter]
     fn children<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyList>> {
         let py = slf.py();
