@@ -190,3 +190,56 @@ def test_mass_bad_density() -> None:
         carom.Sphere(1).mass_properties("dense")  # type: ignore[arg-type]
     m, com, inertia = carom.Plane([0, 1, 0], 0).mass_properties()
     assert m == 0.0 and not inertia.any()
+
+
+@settings(max_examples=40, deadline=None)
+@given(
+    seed=st.integers(0, 2**32 - 1),
+    n=st.integers(4, 20),
+    flatten=st.sampled_from([1.0, 1e-3, 1e-7, 0.0]),
+    offset=st.sampled_from([0.0, 1e3]),
+)
+def test_random_hulls_contain_their_points_or_are_rejected(seed: int, n: int, flatten: float, offset: float) -> None:
+    rng = np.random.default_rng(seed)
+    pts = rng.normal(size=(n, 3)) * [1.0, 1.0, flatten] + offset
+    if rng.uniform() < 0.3:
+        pts = np.vstack([pts, pts[: n // 2]])  # duplicates
+    try:
+        hull = carom.ConvexHull(pts)
+    except carom.CaromError as e:
+        # Far from the origin the core's (temporary, brute-force) builder uses a tolerance
+        # relative to the coordinates' magnitude, so thin-ish clouds may be rejected there.
+        assert flatten < 1.0 or offset > 0, f"a 3D cloud was rejected: {e}"
+        assert "coplanar" in str(e) or "collinear" in str(e)
+        return
+    normals, offsets = hull_planes(hull)
+    scale = np.abs(pts).max() + 1.0
+    assert np.all(pts @ normals.T <= offsets + 1e-4 * scale)
+    assert np.min(np.linalg.norm(hull.vertices[:, None] - pts[None], axis=2), axis=1).max() <= 1e-5 * scale
+    assert hull.volume > 0
+
+
+def test_batches_from_several_threads_agree() -> None:
+    from concurrent.futures import ThreadPoolExecutor
+
+    rng = np.random.default_rng(2)
+    shape = carom.ConvexHull(rng.normal(size=(12, 3)))
+    dirs = [rng.normal(size=(5000, 3)) for _ in range(4)]
+    serial = [shape.support(d) for d in dirs]
+    with ThreadPoolExecutor(4) as pool:
+        threaded = list(pool.map(shape.support, dirs))
+    for a, b in zip(serial, threaded):
+        np.testing.assert_array_equal(a, b)
+
+
+def test_regression_no_faceless_hull_far_from_origin() -> None:
+    # The brute-force builder returned a hull without vertices for these points (and
+    # `support` then panicked); the binding now rejects such hulls.
+    pts = np.random.default_rng(0).normal(size=(4, 3)) + 1000.0
+    try:
+        hull = carom.ConvexHull(pts)
+    except carom.CaromError as e:
+        assert "coplanar" in str(e)
+        return
+    assert len(hull.vertices) == 4 and len(hull.faces) == 4 and hull.volume > 0
+    assert hull.support([1, 0, 0]).shape == (3,)

@@ -4,12 +4,14 @@
 //! Each constructor is the one place its core constructor is called.
 
 use crate::convert::{index_triples, indices_out, triples_out, vec3_out, vec3s, vec3s_out};
-use crate::errors::core;
+use crate::errors::{carom_err, core};
 use crate::pose::{extract_isometry, Pose64, PyPose};
+use crate::serialize::hull_problem;
 use crate::shape::{scale_factors, PyShape};
 use crate::shapes::{init, shape_of, wrap_shape, wrong_kind};
 use carom_collision::math::Isometry;
 use carom_collision::shape::{Compound, ConvexHull, Scaled, Shape, TriMesh};
+use carom_collision::CaromError;
 use numpy::{PyArray1, PyArray2};
 use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
@@ -35,6 +37,16 @@ impl PyConvexHull {
     fn new(py: Python<'_>, points: &Bound<'_, PyAny>) -> PyResult<PyClassInitializer<Self>> {
         let (pts, _) = vec3s(points, "points", false)?;
         let hull = py.detach(move || core(|| ConvexHull::new(&pts)))?;
+        // Guard against degenerate hulls the core builder lets through (nearly coplanar
+        // points far from the origin can give a hull without faces or volume).
+        if let Some(reason) = hull_problem(&hull) {
+            return Err(carom_err(CaromError::degenerate(
+                "convex hull",
+                format!(
+                    "the points are (nearly) coplanar or collinear for this precision: {reason}"
+                ),
+            )));
+        }
         Ok(init(hull.into(), PyConvexHull))
     }
 

@@ -80,7 +80,10 @@ fn validate(shape: &Shape, depth: usize) -> Result<()> {
             s,
             "cone",
         ),
-        Shape::ConvexHull(h) => validate_hull(h),
+        Shape::ConvexHull(h) => match hull_problem(h) {
+            None => Ok(()),
+            Some(reason) => Err(parse_err(format!("invalid convex hull: {reason}"))),
+        },
         Shape::Triangle(t) => same(Triangle::new(t.a, t.b, t.c)?, t, "triangle"),
         Shape::Plane(p) => {
             let rebuilt = Plane::new(p.normal(), p.offset())?;
@@ -119,10 +122,13 @@ fn validate(shape: &Shape, depth: usize) -> Result<()> {
     }
 }
 
-fn validate_hull(h: &ConvexHull) -> Result<()> {
+/// The first broken invariant of a hull (which the core's constructor should guarantee),
+/// or `None`: at least 4 finite vertices, indices in range, well-formed faces (at least 4)
+/// and a positive volume.
+pub fn hull_problem(h: &ConvexHull) -> Option<&'static str> {
     let nv = h.vertices().len();
     if nv < 4 || h.vertices().iter().any(|v| !v.is_finite()) {
-        return Err(parse_err("convex hull vertices are missing or not finite"));
+        return Some("fewer than 4 finite vertices");
     }
     let fvi = h.face_vertex_indices();
     let in_range = |i: u32| (i as usize) < nv;
@@ -130,16 +136,16 @@ fn validate_hull(h: &ConvexHull) -> Result<()> {
         || !h.triangles().iter().flatten().all(|&i| in_range(i))
         || !h.edges().iter().flatten().all(|&i| in_range(i))
     {
-        return Err(parse_err("convex hull index out of range"));
+        return Some("a vertex index is out of range");
     }
     for f in h.faces() {
         let end = u64::from(f.first) + u64::from(f.count);
         if f.count < 3 || end > fvi.len() as u64 || !f.normal.is_finite() || !f.offset.is_finite() {
-            return Err(parse_err("inconsistent convex hull face"));
+            return Some("a face is malformed");
         }
     }
     if h.faces().len() < 4 || !h.volume().is_finite() || h.volume() <= 0.0 {
-        return Err(parse_err("convex hull has no volume"));
+        return Some("it has fewer than 4 faces or no volume");
     }
-    Ok(())
+    None
 }
