@@ -1,22 +1,51 @@
-//! Convex hull construction.
+//! Convex hull construction: quickhull.
 //!
-//! TEMPORARY: a brute-force hull (every plane through three points that has all points on
-//! one side), O(n⁴). It is replaced by quickhull in this same session and then kept in the
-//! tests as the oracle.
+//! C. B. Barber, D. P. Dobkin & H. Huhdanpaa, "The Quickhull Algorithm for Convex Hulls",
+//! ACM TOMS 22(4), 1996, with the robustness measures of D. Gregorius, "Implementing
+//! Quickhull" (GDC 2014), also used by Jolt's `ConvexHullBuilder`:
+//!
+//! - the cloud is shifted to the centre of its bounding box and scaled by a power of two
+//!   (exact) to unit size, so far-from-origin, tiny and huge clouds behave alike;
+//! - "thick" planes: a point counts as outside a face only if it is more than
+//!   `tol = 3 ε (max|x| + max|y| + max|z|)` above it; points within `tol` of the hull are
+//!   dropped;
+//! - a robust initial tetrahedron (extreme points, then the furthest from their line, then the
+//!   furthest from their plane), which is also where flat and degenerate inputs are detected;
+//! - conflict lists (each outside point belongs to one face it is above), the horizon found by
+//!   a depth-first search that yields it as an ordered loop, and a check that it is one simple
+//!   loop;
+//! - the triangles are then merged into convex polygons (see `quickhull_merge`).
+//!
+//! If a step meets an inconsistency that only rounding can cause (a horizon that is not a simple
+//! loop, a zero-area face, a non-manifold result), the build restarts with a larger tolerance;
+//! the number of iterations is capped by the number of points, so it always terminates.
 
+use super::quickhull_merge::{merge_triangles, Triangle};
 use crate::error::{CaromError, Result};
-use crate::math::{Real, Vec3};
+use crate::math::{Real, Vec3, EPSILON};
 
 /// A hull as convex polygons over its own vertex list.
 #[derive(Debug, Clone, PartialEq)]
 pub struct HullPolygons {
-    /// Hull vertices.
+    /// Hull vertices (a subset of the input points, unchanged).
     pub vertices: Vec<Vec3>,
-    /// Faces: counter-clockwise (from outside) loops of indices into `vertices`.
+    /// Faces: counter-clockwise (from outside) loops of indices into `vertices`. Each face is a
+    /// convex polygon without collinear vertices; adjacent faces are not coplanar.
     pub faces: Vec<Vec<u32>>,
 }
 
-/// Brute-force hull of `points`.
+/// Multipliers of the base tolerance tried in turn when rounding makes a build inconsistent.
+const TOLERANCE_SCALES: [Real; 4] = [1.0, 16.0, 256.0, 4096.0];
+
+/// "No face".
+pub(super) const NONE: u32 = u32::MAX;
+
+/// The convex hull of `points` by quickhull (see the module documentation).
+///
+/// Duplicate, coplanar, nearly coplanar and interior points are handled. Fails with a
+/// [`CaromError`] naming the problem when there is no 3D hull: fewer than 4 points, a NaN or
+/// infinite coordinate, or all points coincident, collinear or coplanar (within the
+/// tolerance).
 pub fn quickhull(points: &[Vec3]) -> Result<HullPolygons> {
     if points.len() < 4 {
         return Err(CaromError::invalid(
@@ -25,101 +54,432 @@ pub fn quickhull(points: &[Vec3]) -> Result<HullPolygons> {
             "need at least 4 points for a 3D convex hull",
         ));
     }
-    let scale = points
-        .iter()
-        .fold(0.0 as Real, |m, p| m.max(p.abs().max_element()))
-        .max(1e-30);
-    let eps = scale * 1e-5;
-    let n = points.len();
-    let mut planes: Vec<(Vec3, Real)> = Vec::new();
-    for i in 0..n {
-        for j in i + 1..n {
-            for k in j + 1..n {
-                let (a, b, c) = (points[i], points[j], points[k]);
-                let Some(nrm) = (b - a).cross(c - a).try_normalize() else {
-                    continue;
-                };
-                let d = nrm.dot(a);
-                let mut above = false;
-                let mut below = false;
-                for p in points {
-                    let s = nrm.dot(*p) - d;
-                    above |= s > eps;
-                    below |= s < -eps;
-                }
-                let plane = match (above, below) {
-                    (false, true) => (nrm, d),
-                    (true, false) => (-nrm, -d),
-                    _ => continue,
-                };
-                if !planes
-                    .iter()
-                    .any(|(m, o)| (*m - plane.0).length() < 1e-4 && (o - plane.1).abs() < eps)
-                {
-                    planes.push(plane);
-                }
-            }
-        }
-    }
-    if planes.len() < 4 {
-        return Err(CaromError::degenerate(
-            "convex hull",
-            "the points are coplanar or collinear: no 3D hull exists",
+    if let Some(i) = points.iter().position(|p| !p.is_finite()) {
+        return Err(CaromError::invalid(
+            format!("points[{i}]"),
+            points[i],
+            "must be finite",
         ));
     }
-    let mut vertices: Vec<Vec3> = Vec::new();
-    let mut faces = Vec::new();
-    for (nrm, d) in &planes {
-        let on: Vec<Vec3> = points
-            .iter()
-            .copied()
-            .filter(|p| (nrm.dot(*p) - d).abs() <= eps)
-            .collect();
-        let (t1, t2) = crate::math::orthonormal_basis(*nrm);
-        let mut pts2: Vec<(Real, Real, Vec3)> =
-            on.iter().map(|p| (p.dot(t1), p.dot(t2), *p)).collect();
-        pts2.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.total_cmp(&b.1)));
-        pts2.dedup_by(|a, b| (a.2 - b.2).length() <= eps);
-        // Andrew's monotone chain (counter-clockwise in the (t1, t2) basis, i.e. about nrm).
-        let cross = |o: &(Real, Real, Vec3), a: &(Real, Real, Vec3), b: &(Real, Real, Vec3)| {
-            (a.0 - o.0) * (b.1 - o.1) - (a.1 - o.1) * (b.0 - o.0)
-        };
-        let mut lower: Vec<(Real, Real, Vec3)> = Vec::new();
-        for p in &pts2 {
-            while lower.len() >= 2
-                && cross(&lower[lower.len() - 2], &lower[lower.len() - 1], p) <= eps * scale
-            {
-                lower.pop();
-            }
-            lower.push(*p);
+    let local = normalize(points)?;
+    let max_abs = local.iter().fold(Vec3::ZERO, |m, p| m.max(p.abs()));
+    let base_tol = 3.0 * EPSILON * (max_abs.x + max_abs.y + max_abs.z);
+    // Thinner than this in some direction counts as flat (fixed across retries).
+    let flat_tol = 16.0 * base_tol;
+    for scale in TOLERANCE_SCALES {
+        match build(&local, base_tol * scale, flat_tol) {
+            Ok(faces) => return Ok(reindex(points, faces)),
+            Err(Failure::Degenerate(e)) => return Err(e),
+            Err(Failure::Numerical) => continue,
         }
-        let mut upper: Vec<(Real, Real, Vec3)> = Vec::new();
-        for p in pts2.iter().rev() {
-            while upper.len() >= 2
-                && cross(&upper[upper.len() - 2], &upper[upper.len() - 1], p) <= eps * scale
-            {
-                upper.pop();
-            }
-            upper.push(*p);
-        }
-        lower.pop();
-        upper.pop();
-        lower.extend(upper);
-        if lower.len() < 3 {
+    }
+    Err(CaromError::degenerate(
+        "convex hull",
+        "quickhull could not build a consistent hull even at its largest tolerance \
+         (numerically degenerate input)",
+    ))
+}
+
+/// Why one build attempt stopped.
+enum Failure {
+    /// The input has no 3D hull: report to the user.
+    Degenerate(CaromError),
+    /// Rounding made the construction inconsistent: retry with a larger tolerance.
+    Numerical,
+}
+
+/// The points shifted to the centre of their bounding box and scaled by a power of two (an
+/// exact operation) so the largest coordinate magnitude lies in `(0.5, 1]`.
+fn normalize(points: &[Vec3]) -> Result<Vec<Vec3>> {
+    let (lo, hi) = points.iter().fold(
+        (Vec3::splat(Real::MAX), Vec3::splat(Real::MIN)),
+        |(lo, hi), p| (lo.min(*p), hi.max(*p)),
+    );
+    // Halve first so the sum cannot overflow.
+    let centre = lo * 0.5 + hi * 0.5;
+    let shifted: Vec<Vec3> = points.iter().map(|p| *p - centre).collect();
+    let extent = shifted
+        .iter()
+        .fold(0.0 as Real, |m, p| m.max(p.abs().max_element()));
+    if !(extent >= Real::MIN_POSITIVE) || !extent.is_finite() {
+        return Err(CaromError::degenerate(
+            "convex hull",
+            "all points coincide (fewer than 4 distinct points)",
+        ));
+    }
+    let scale = (2.0 as Real).powi(-(extent.log2().ceil() as i32));
+    if !scale.is_finite() {
+        return Err(CaromError::degenerate(
+            "convex hull",
+            format!("the point cloud's extent {extent:?} is too small or too large to represent"),
+        ));
+    }
+    Ok(shifted.into_iter().map(|p| p * scale).collect())
+}
+
+/// Maps polygons over input point indices to polygons over their own vertex list, in order of
+/// first appearance (deterministic).
+fn reindex(points: &[Vec3], faces: Vec<Vec<u32>>) -> HullPolygons {
+    let mut map = vec![NONE; points.len()];
+    let mut vertices = Vec::new();
+    let faces = faces
+        .into_iter()
+        .map(|face| {
+            face.into_iter()
+                .map(|i| {
+                    if map[i as usize] == NONE {
+                        map[i as usize] = vertices.len() as u32;
+                        vertices.push(points[i as usize]);
+                    }
+                    map[i as usize]
+                })
+                .collect()
+        })
+        .collect();
+    HullPolygons { vertices, faces }
+}
+
+/// A triangle of the hull under construction.
+struct Face {
+    /// Vertices (point indices), counter-clockwise seen from outside.
+    v: [u32; 3],
+    /// `adj[i]`: the face across the edge `v[i] → v[(i + 1) % 3]`.
+    adj: [u32; 3],
+    /// Unit outward normal.
+    normal: Vec3,
+    /// Plane offset: `normal · x = offset` on the face.
+    offset: Real,
+    /// Outside points assigned to this face.
+    conflict: Vec<u32>,
+    /// False once removed from the hull.
+    alive: bool,
+}
+
+impl Face {
+    fn distance(&self, p: Vec3) -> Real {
+        self.normal.dot(p) - self.offset
+    }
+}
+
+/// The unit normal and offset of triangle `(a, b, c)`, or `None` if it has no area. The normal
+/// is the cross product of the two shortest edges, the most accurate choice.
+pub(super) fn triangle_plane(a: Vec3, b: Vec3, c: Vec3) -> Option<(Vec3, Real)> {
+    let (e0, e1, e2) = (b - a, c - b, a - c);
+    let (l0, l1, l2) = (
+        e0.length_squared(),
+        e1.length_squared(),
+        e2.length_squared(),
+    );
+    let n = if l0 >= l1 && l0 >= l2 {
+        e1.cross(e2)
+    } else if l1 >= l2 {
+        e2.cross(e0)
+    } else {
+        e0.cross(e1)
+    };
+    let n = n.try_normalize()?;
+    Some((n, n.dot((a + b + c) * (1.0 / 3.0))))
+}
+
+/// One build attempt at tolerance `tol`: polygons over point indices. Inputs thinner than
+/// `flat_tol` are rejected as coincident, collinear or coplanar.
+fn build(pts: &[Vec3], tol: Real, flat_tol: Real) -> std::result::Result<Vec<Vec<u32>>, Failure> {
+    let mut hull = Builder::new(pts, tol, flat_tol)?;
+    // Every iteration removes its eye point for good, so `pts.len()` bounds the iterations.
+    let mut pending: Vec<u32> = (0..hull.faces.len() as u32).collect();
+    let mut iterations = 0;
+    while let Some(f) = pending.pop() {
+        let face = &hull.faces[f as usize];
+        if !face.alive || face.conflict.is_empty() {
             continue;
         }
-        let mut face = Vec::new();
-        for (_, _, p) in lower {
-            let idx = match vertices.iter().position(|v| (*v - p).length() <= eps) {
-                Some(i) => i,
-                None => {
-                    vertices.push(p);
-                    vertices.len() - 1
-                }
-            };
-            face.push(idx as u32);
+        iterations += 1;
+        if iterations > pts.len() {
+            return Err(Failure::Numerical);
         }
-        faces.push(face);
+        let eye = face
+            .conflict
+            .iter()
+            .copied()
+            .map(|i| (i, face.distance(pts[i as usize])))
+            .fold(
+                (NONE, Real::MIN),
+                |best, c| if c.1 > best.1 { c } else { best },
+            )
+            .0;
+        hull.add_point(f, eye, &mut pending)?;
     }
-    Ok(HullPolygons { vertices, faces })
+    let alive: Vec<u32> = (0..hull.faces.len() as u32)
+        .filter(|&f| hull.faces[f as usize].alive)
+        .collect();
+    let mut compact = vec![NONE; hull.faces.len()];
+    for (k, &f) in alive.iter().enumerate() {
+        compact[f as usize] = k as u32;
+    }
+    let triangles: Vec<Triangle> = alive
+        .iter()
+        .map(|&f| {
+            let face = &hull.faces[f as usize];
+            Triangle {
+                v: face.v,
+                adj: face.adj.map(|a| compact[a as usize]),
+                normal: face.normal,
+                offset: face.offset,
+            }
+        })
+        .collect();
+    if triangles.iter().any(|t| t.adj.contains(&NONE)) {
+        return Err(Failure::Numerical);
+    }
+    merge_triangles(pts, &triangles, 2.0 * tol).ok_or(Failure::Numerical)
+}
+
+/// The triangle hull under construction.
+struct Builder<'a> {
+    pts: &'a [Vec3],
+    tol: Real,
+    faces: Vec<Face>,
+    /// Per face: `stamp` if found visible in the current step, `stamp + 1` if not.
+    mark: Vec<u32>,
+    /// Per point: `stamp` if it is on the current horizon.
+    on_horizon: Vec<u32>,
+    stamp: u32,
+}
+
+impl<'a> Builder<'a> {
+    /// The initial tetrahedron, with every other point assigned to a face it is above.
+    fn new(pts: &'a [Vec3], tol: Real, flat_tol: Real) -> std::result::Result<Self, Failure> {
+        let [a, b, c, d] = initial_simplex(pts, flat_tol)?;
+        let mut hull = Builder {
+            pts,
+            tol,
+            faces: Vec::new(),
+            mark: Vec::new(),
+            on_horizon: vec![0; pts.len()],
+            stamp: 0,
+        };
+        // (a, b, c) faces away from d; the other faces follow from consistent orientation.
+        let tris = [[a, b, c], [b, a, d], [c, b, d], [a, c, d]];
+        for t in tris {
+            hull.push_face(t)?;
+        }
+        for f in 0..4 {
+            for i in 0..3 {
+                let (u, v) = (tris[f][i], tris[f][(i + 1) % 3]);
+                let twin = (0..4)
+                    .find(|&g| (0..3).any(|j| tris[g][j] == v && tris[g][(j + 1) % 3] == u))
+                    .ok_or(Failure::Numerical)?;
+                hull.faces[f].adj[i] = twin as u32;
+            }
+        }
+        let new_faces = [0, 1, 2, 3];
+        for i in 0..pts.len() as u32 {
+            if ![a, b, c, d].contains(&i) {
+                hull.assign(i, &new_faces);
+            }
+        }
+        Ok(hull)
+    }
+
+    /// Appends a face with the plane of `v` (adjacency left unset).
+    fn push_face(&mut self, v: [u32; 3]) -> std::result::Result<u32, Failure> {
+        let [a, b, c] = v.map(|i| self.pts[i as usize]);
+        let (normal, offset) = triangle_plane(a, b, c).ok_or(Failure::Numerical)?;
+        self.faces.push(Face {
+            v,
+            adj: [NONE; 3],
+            normal,
+            offset,
+            conflict: Vec::new(),
+            alive: true,
+        });
+        self.mark.push(0);
+        Ok(self.faces.len() as u32 - 1)
+    }
+
+    /// Puts point `i` on the conflict list of the face among `candidates` it is furthest
+    /// above, or drops it if it is within the tolerance of all of them.
+    fn assign(&mut self, i: u32, candidates: &[u32]) {
+        let p = self.pts[i as usize];
+        let mut best = (NONE, self.tol);
+        for &f in candidates {
+            let d = self.faces[f as usize].distance(p);
+            if d > best.1 {
+                best = (f, d);
+            }
+        }
+        if best.0 != NONE {
+            self.faces[best.0 as usize].conflict.push(i);
+        }
+    }
+
+    /// Adds the point `eye` (outside face `start`): removes the faces it sees and connects it
+    /// to their horizon.
+    fn add_point(
+        &mut self,
+        start: u32,
+        eye: u32,
+        pending: &mut Vec<u32>,
+    ) -> std::result::Result<(), Failure> {
+        let p = self.pts[eye as usize];
+        self.stamp = self.stamp.wrapping_add(2);
+        if self.stamp == 0 {
+            self.mark.iter_mut().for_each(|m| *m = u32::MAX);
+            self.on_horizon.iter_mut().for_each(|m| *m = u32::MAX);
+            self.stamp = 2;
+        }
+        let (visible, horizon) = self.find_horizon(start, p);
+        // The horizon must be one simple closed loop of at least 3 edges.
+        let m = horizon.len();
+        if m < 3 {
+            return Err(Failure::Numerical);
+        }
+        for k in 0..m {
+            let (f, i) = horizon[k];
+            let (g, j) = horizon[(k + 1) % m];
+            let end = self.faces[f as usize].v[(i + 1) % 3];
+            if end != self.faces[g as usize].v[j] || self.on_horizon[end as usize] == self.stamp {
+                return Err(Failure::Numerical);
+            }
+            self.on_horizon[end as usize] = self.stamp;
+        }
+        // The cone of new faces from the eye to every horizon edge.
+        let first = self.faces.len() as u32;
+        for &(f, i) in &horizon {
+            let face = &self.faces[f as usize];
+            let (a, b, across) = (face.v[i], face.v[(i + 1) % 3], face.adj[i]);
+            let nf = self.push_face([a, b, eye])?;
+            let twin = &mut self.faces[across as usize];
+            let j = (0..3)
+                .find(|&j| twin.v[j] == b && twin.v[(j + 1) % 3] == a)
+                .ok_or(Failure::Numerical)?;
+            twin.adj[j] = nf;
+            self.faces[nf as usize].adj[0] = across;
+        }
+        let m = m as u32;
+        for k in 0..m {
+            let nf = &mut self.faces[(first + k) as usize];
+            nf.adj[1] = first + (k + 1) % m;
+            nf.adj[2] = first + (k + m - 1) % m;
+        }
+        // Hand the visible faces' outside points to the new faces.
+        let new_faces: Vec<u32> = (first..first + m).collect();
+        for &f in &visible {
+            let face = &mut self.faces[f as usize];
+            face.alive = false;
+            let conflict = std::mem::take(&mut face.conflict);
+            for i in conflict {
+                if i != eye {
+                    self.assign(i, &new_faces);
+                }
+            }
+        }
+        pending.extend(
+            new_faces
+                .iter()
+                .copied()
+                .filter(|&f| !self.faces[f as usize].conflict.is_empty()),
+        );
+        Ok(())
+    }
+
+    /// The faces `p` sees (connected to `start`) and the horizon as an ordered list of
+    /// `(face, edge)` pairs: visible faces' edges whose other face is not visible, in
+    /// counter-clockwise order around the visible region (Gregorius' depth-first search,
+    /// entering each face after the edge it was reached through).
+    fn find_horizon(&mut self, start: u32, p: Vec3) -> (Vec<u32>, Vec<(u32, usize)>) {
+        let stamp = self.stamp;
+        let mut visible = vec![start];
+        let mut horizon = Vec::new();
+        self.mark[start as usize] = stamp;
+        // (face, first edge, edges done)
+        let mut stack: Vec<(u32, usize, usize)> = vec![(start, 0, 0)];
+        while let Some(top) = stack.last_mut() {
+            if top.2 == 3 {
+                stack.pop();
+                continue;
+            }
+            let (f, i) = (top.0, (top.1 + top.2) % 3);
+            top.2 += 1;
+            let nb = self.faces[f as usize].adj[i];
+            let mark = self.mark[nb as usize];
+            if mark == stamp {
+                continue;
+            }
+            if mark != stamp + 1 && self.faces[nb as usize].distance(p) > self.tol {
+                self.mark[nb as usize] = stamp;
+                visible.push(nb);
+                let back = (0..3)
+                    .find(|&j| self.faces[nb as usize].adj[j] == f)
+                    .unwrap_or(0);
+                // Start after the edge we came through (that one leads back, already visible).
+                stack.push((nb, back + 1, 0));
+            } else {
+                self.mark[nb as usize] = stamp + 1;
+                horizon.push((f, i));
+            }
+        }
+        (visible, horizon)
+    }
+}
+
+/// Four points spanning a large tetrahedron, or why there are none (all points within `tol`
+/// of one point, line or plane).
+fn initial_simplex(pts: &[Vec3], tol: Real) -> std::result::Result<[u32; 4], Failure> {
+    let degenerate =
+        |reason: &str| Failure::Degenerate(CaromError::degenerate("convex hull", reason));
+    // The extreme points along the axes; the pair furthest apart.
+    let mut extremes = [0u32; 6];
+    for (i, p) in pts.iter().enumerate() {
+        for axis in 0..3 {
+            if p[axis] < pts[extremes[2 * axis] as usize][axis] {
+                extremes[2 * axis] = i as u32;
+            }
+            if p[axis] > pts[extremes[2 * axis + 1] as usize][axis] {
+                extremes[2 * axis + 1] = i as u32;
+            }
+        }
+    }
+    let mut best = (0.0 as Real, 0u32, 0u32);
+    for &i in &extremes {
+        for &j in &extremes {
+            let d = (pts[i as usize] - pts[j as usize]).length_squared();
+            if d > best.0 {
+                best = (d, i, j);
+            }
+        }
+    }
+    let (a, b) = (best.1, best.2);
+    if best.0.sqrt() <= tol {
+        return Err(degenerate(
+            "all points coincide (fewer than 4 distinct points)",
+        ));
+    }
+    let (pa, pb) = (pts[a as usize], pts[b as usize]);
+    let dir = (pb - pa).normalize();
+    let furthest = |score: &dyn Fn(Vec3) -> Real| {
+        pts.iter()
+            .enumerate()
+            .map(|(i, p)| (i as u32, score(*p)))
+            .fold(
+                (0u32, Real::MIN),
+                |best, c| if c.1 > best.1 { c } else { best },
+            )
+    };
+    let (c, dist_c) = furthest(&|p| (p - pa).cross(dir).length());
+    if dist_c <= tol {
+        return Err(degenerate("all points are collinear: no 3D hull exists"));
+    }
+    let pc = pts[c as usize];
+    let (n, _) = triangle_plane(pa, pb, pc).ok_or(Failure::Numerical)?;
+    let (d, dist_d) = furthest(&|p| n.dot(p - pa).abs());
+    if dist_d <= tol {
+        return Err(degenerate("all points are coplanar: no 3D hull exists"));
+    }
+    // Orient (a, b, c) so that it faces away from d.
+    if n.dot(pts[d as usize] - pa) > 0.0 {
+        Ok([a, c, b, d])
+    } else {
+        Ok([a, b, c, d])
+    }
 }
