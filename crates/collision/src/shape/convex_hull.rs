@@ -41,7 +41,8 @@ pub struct ConvexHull {
     triangles: Vec<[u32; 3]>,
     local_aabb: Aabb,
     volume: Real,
-    unit_mass: MassProperties,
+    /// Boxed to keep `Shape` small.
+    unit_mass: Box<MassProperties>,
 }
 
 impl ConvexHull {
@@ -68,24 +69,28 @@ impl ConvexHull {
         let mut triangles = Vec::new();
         let mut edges = Vec::new();
         for poly in &faces {
-            // Newell's method: a robust normal for a planar polygon.
+            // The normal: the corner cross products (v_k − v_{k−1}) × (v_{k+1} − v_k) all point
+            // along it for a convex polygon. Built from edge vectors (differences of nearby
+            // floats, exact) rather than positions as in Newell's method, and weighted by the
+            // sine of the corner angle, it stays accurate far from the origin and for slivers,
+            // where corners between two long, nearly parallel edges carry large relative
+            // rounding errors.
+            let count = poly.len();
+            let at = |k: usize| vertices[poly[k % count] as usize];
             let mut n = Vec3::ZERO;
-            let mut centroid = Vec3::ZERO;
-            for (k, &i) in poly.iter().enumerate() {
-                let p = vertices[i as usize];
-                let q = vertices[poly[(k + 1) % poly.len()] as usize];
-                n += Vec3::new(
-                    (p.y - q.y) * (p.z + q.z),
-                    (p.z - q.z) * (p.x + q.x),
-                    (p.x - q.x) * (p.y + q.y),
-                );
-                centroid += p;
+            for k in 0..count {
+                let (e1, e2) = (at(k) - at(k + count - 1), at(k + 1) - at(k));
+                let corner = e1.cross(e2);
+                let lengths = e1.length() * e2.length();
+                if lengths > 0.0 {
+                    n += corner * (corner.length() / lengths);
+                }
             }
-            centroid /= poly.len() as Real;
             let normal = n.normalize_or_zero();
+            let offset = (0..count).map(|k| normal.dot(at(k))).sum::<Real>() / count as Real;
             hull_faces.push(HullFace {
                 normal,
-                offset: normal.dot(centroid),
+                offset,
                 first: face_vertex_indices.len() as u32,
                 count: poly.len() as u32,
             });
@@ -115,7 +120,7 @@ impl ConvexHull {
             triangles,
             local_aabb,
             volume,
-            unit_mass,
+            unit_mass: Box::new(unit_mass),
         }
     }
 

@@ -66,9 +66,44 @@ pub fn quickhull(points: &[Vec3]) -> Result<HullPolygons> {
     let base_tol = 3.0 * EPSILON * (max_abs.x + max_abs.y + max_abs.z);
     // Thinner than this in some direction counts as flat (fixed across retries).
     let flat_tol = 16.0 * base_tol;
+    // Points kept so far (indices into `points`) and the last hull built.
+    let mut active: Vec<u32> = (0..points.len() as u32).collect();
+    let mut last = None;
+    for _ in 0..MAX_ROUNDS {
+        let subset: Vec<Vec3> = active.iter().map(|&i| local[i as usize]).collect();
+        let (faces, redundant) = match build_with_retries(&subset, base_tol, flat_tol) {
+            Ok(built) => built,
+            Err(e) => return last.map(|faces| reindex(points, faces)).ok_or(e),
+        };
+        let faces: Vec<Vec<u32>> = faces
+            .into_iter()
+            .map(|f| f.into_iter().map(|i| active[i as usize]).collect())
+            .collect();
+        if redundant.is_empty() {
+            return Ok(reindex(points, faces));
+        }
+        // Hull vertices that lie within the tolerance of the hull of the others (reflex or
+        // collinear in a face): build again without them.
+        let redundant: Vec<u32> = redundant.iter().map(|&i| active[i as usize]).collect();
+        active.retain(|i| !redundant.contains(i));
+        last = Some(faces);
+    }
+    Ok(reindex(points, last.unwrap_or_default()))
+}
+
+/// At most this many builds drop redundant vertices and start again.
+const MAX_ROUNDS: usize = 8;
+
+/// Builds the hull of `pts`, retrying with larger tolerances when rounding makes a build
+/// inconsistent. Returns the polygons and the redundant vertices found (see `build`).
+fn build_with_retries(
+    pts: &[Vec3],
+    base_tol: Real,
+    flat_tol: Real,
+) -> Result<(Vec<Vec<u32>>, Vec<u32>)> {
     for scale in TOLERANCE_SCALES {
-        match build(&local, base_tol * scale, flat_tol) {
-            Ok(faces) => return Ok(reindex(points, faces)),
+        match build(pts, base_tol * scale, flat_tol) {
+            Ok(built) => return Ok(built),
             Err(Failure::Degenerate(e)) => return Err(e),
             Err(Failure::Numerical) => continue,
         }
@@ -101,7 +136,7 @@ fn normalize(points: &[Vec3]) -> Result<Vec<Vec3>> {
     let extent = shifted
         .iter()
         .fold(0.0 as Real, |m, p| m.max(p.abs().max_element()));
-    if !(extent >= Real::MIN_POSITIVE) || !extent.is_finite() {
+    if extent < Real::MIN_POSITIVE || !extent.is_finite() {
         return Err(CaromError::degenerate(
             "convex hull",
             "all points coincide (fewer than 4 distinct points)",
@@ -145,25 +180,29 @@ struct Face {
     v: [u32; 3],
     /// `adj[i]`: the face across the edge `v[i] → v[(i + 1) % 3]`.
     adj: [u32; 3],
-    /// Unit outward normal.
-    normal: Vec3,
-    /// Plane offset: `normal · x = offset` on the face.
-    offset: Real,
+    /// Its plane, in `Builder::planes` (shared by coplanar neighbours).
+    plane: u32,
     /// Outside points assigned to this face.
     conflict: Vec<u32>,
     /// False once removed from the hull.
     alive: bool,
 }
 
-impl Face {
-    fn distance(&self, p: Vec3) -> Real {
-        self.normal.dot(p) - self.offset
-    }
+/// A plane shared by a group of coplanar faces (Gregorius merges such faces; sharing one
+/// plane, the best-conditioned one, keeps their visibility tests consistent in the same way).
+#[derive(Clone, Copy)]
+struct Plane {
+    /// Unit outward normal.
+    normal: Vec3,
+    /// Offset: `normal · x = offset` on the plane.
+    offset: Real,
+    /// Twice the area of the triangle it was computed from (larger is better conditioned).
+    area: Real,
 }
 
-/// The unit normal and offset of triangle `(a, b, c)`, or `None` if it has no area. The normal
-/// is the cross product of the two shortest edges, the most accurate choice.
-pub(super) fn triangle_plane(a: Vec3, b: Vec3, c: Vec3) -> Option<(Vec3, Real)> {
+/// The plane of triangle `(a, b, c)`, or `None` if it has no area. The normal is the cross
+/// product of the two shortest edges, the most accurate choice.
+fn triangle_plane(a: Vec3, b: Vec3, c: Vec3) -> Option<Plane> {
     let (e0, e1, e2) = (b - a, c - b, a - c);
     let (l0, l1, l2) = (
         e0.length_squared(),
@@ -177,13 +216,22 @@ pub(super) fn triangle_plane(a: Vec3, b: Vec3, c: Vec3) -> Option<(Vec3, Real)> 
     } else {
         e0.cross(e1)
     };
+    let area = n.length();
     let n = n.try_normalize()?;
-    Some((n, n.dot((a + b + c) * (1.0 / 3.0))))
+    Some(Plane {
+        normal: n,
+        offset: n.dot((a + b + c) * (1.0 / 3.0)),
+        area,
+    })
 }
 
-/// One build attempt at tolerance `tol`: polygons over point indices. Inputs thinner than
-/// `flat_tol` are rejected as coincident, collinear or coplanar.
-fn build(pts: &[Vec3], tol: Real, flat_tol: Real) -> std::result::Result<Vec<Vec<u32>>, Failure> {
+/// A hull as polygons over point indices, and the redundant vertices found while merging.
+type Built = (Vec<Vec<u32>>, Vec<u32>);
+
+/// One build attempt at tolerance `tol`: polygons over point indices, and the hull vertices
+/// found redundant (see `merge_triangles`). Inputs thinner than `flat_tol` are rejected as
+/// coincident, collinear or coplanar.
+fn build(pts: &[Vec3], tol: Real, flat_tol: Real) -> std::result::Result<Built, Failure> {
     let mut hull = Builder::new(pts, tol, flat_tol)?;
     // Every iteration removes its eye point for good, so `pts.len()` bounds the iterations.
     let mut pending: Vec<u32> = (0..hull.faces.len() as u32).collect();
@@ -197,17 +245,24 @@ fn build(pts: &[Vec3], tol: Real, flat_tol: Real) -> std::result::Result<Vec<Vec
         if iterations > pts.len() {
             return Err(Failure::Numerical);
         }
-        let eye = face
+        let (eye, dist) = face
             .conflict
             .iter()
-            .copied()
-            .map(|i| (i, face.distance(pts[i as usize])))
+            .map(|&i| (i, hull.distance(f, pts[i as usize])))
             .fold(
                 (NONE, Real::MIN),
                 |best, c| if c.1 > best.1 { c } else { best },
-            )
-            .0;
+            );
+        if dist <= tol {
+            // The face's shared plane was refined since: its points are on the hull now.
+            hull.faces[f as usize].conflict.clear();
+            continue;
+        }
         hull.add_point(f, eye, &mut pending)?;
+        // Unless the eye was dropped, `f` is gone; otherwise look at it again.
+        if hull.faces[f as usize].alive {
+            pending.push(f);
+        }
     }
     let alive: Vec<u32> = (0..hull.faces.len() as u32)
         .filter(|&f| hull.faces[f as usize].alive)
@@ -220,11 +275,12 @@ fn build(pts: &[Vec3], tol: Real, flat_tol: Real) -> std::result::Result<Vec<Vec
         .iter()
         .map(|&f| {
             let face = &hull.faces[f as usize];
+            let plane = hull.planes[face.plane as usize];
             Triangle {
                 v: face.v,
                 adj: face.adj.map(|a| compact[a as usize]),
-                normal: face.normal,
-                offset: face.offset,
+                normal: plane.normal,
+                offset: plane.offset,
             }
         })
         .collect();
@@ -239,6 +295,7 @@ struct Builder<'a> {
     pts: &'a [Vec3],
     tol: Real,
     faces: Vec<Face>,
+    planes: Vec<Plane>,
     /// Per face: `stamp` if found visible in the current step, `stamp + 1` if not.
     mark: Vec<u32>,
     /// Per point: `stamp` if it is on the current horizon.
@@ -254,6 +311,7 @@ impl<'a> Builder<'a> {
             pts,
             tol,
             faces: Vec::new(),
+            planes: Vec::new(),
             mark: Vec::new(),
             on_horizon: vec![0; pts.len()],
             stamp: 0,
@@ -261,7 +319,7 @@ impl<'a> Builder<'a> {
         // (a, b, c) faces away from d; the other faces follow from consistent orientation.
         let tris = [[a, b, c], [b, a, d], [c, b, d], [a, c, d]];
         for t in tris {
-            hull.push_face(t)?;
+            hull.push_face(t, None)?;
         }
         for f in 0..4 {
             for i in 0..3 {
@@ -281,15 +339,37 @@ impl<'a> Builder<'a> {
         Ok(hull)
     }
 
-    /// Appends a face with the plane of `v` (adjacency left unset).
-    fn push_face(&mut self, v: [u32; 3]) -> std::result::Result<u32, Failure> {
+    /// Signed distance of `p` above the plane of face `f`.
+    fn distance(&self, f: u32, p: Vec3) -> Real {
+        let plane = &self.planes[self.faces[f as usize].plane as usize];
+        plane.normal.dot(p) - plane.offset
+    }
+
+    /// Appends a face (adjacency left unset) with its own plane, or sharing the plane `group`
+    /// of a coplanar neighbour (which it refines if it is better conditioned).
+    fn push_face(&mut self, v: [u32; 3], group: Option<u32>) -> std::result::Result<u32, Failure> {
         let [a, b, c] = v.map(|i| self.pts[i as usize]);
-        let (normal, offset) = triangle_plane(a, b, c).ok_or(Failure::Numerical)?;
+        let own = triangle_plane(a, b, c).ok_or(Failure::Numerical)?;
+        let plane = match group {
+            Some(g) => {
+                let shared = &mut self.planes[g as usize];
+                if own.normal.dot(shared.normal) <= 0.0 {
+                    return Err(Failure::Numerical); // folded over its neighbour
+                }
+                if own.area > shared.area {
+                    *shared = own;
+                }
+                g
+            }
+            None => {
+                self.planes.push(own);
+                self.planes.len() as u32 - 1
+            }
+        };
         self.faces.push(Face {
             v,
             adj: [NONE; 3],
-            normal,
-            offset,
+            plane,
             conflict: Vec::new(),
             alive: true,
         });
@@ -303,7 +383,7 @@ impl<'a> Builder<'a> {
         let p = self.pts[i as usize];
         let mut best = (NONE, self.tol);
         for &f in candidates {
-            let d = self.faces[f as usize].distance(p);
+            let d = self.distance(f, p);
             if d > best.1 {
                 best = (f, d);
             }
@@ -343,12 +423,34 @@ impl<'a> Builder<'a> {
             }
             self.on_horizon[end as usize] = self.stamp;
         }
-        // The cone of new faces from the eye to every horizon edge.
-        let first = self.faces.len() as u32;
+        // A new face coplanar with the face across its horizon edge shares that face's plane.
+        // If the eye is coplanar with that face but not clearly beyond the edge, it lies on
+        // the hull (it only looked visible through a poorly conditioned plane): drop it.
+        let mut groups = Vec::with_capacity(m);
         for &(f, i) in &horizon {
             let face = &self.faces[f as usize];
             let (a, b, across) = (face.v[i], face.v[(i + 1) % 3], face.adj[i]);
-            let nf = self.push_face([a, b, eye])?;
+            let plane = self.faces[across as usize].plane;
+            if self.distance(across, p).abs() > self.tol {
+                groups.push(None);
+                continue;
+            }
+            let (pa, pb) = (self.pts[a as usize], self.pts[b as usize]);
+            let beyond = (pb - pa)
+                .cross(p - pa)
+                .dot(self.planes[plane as usize].normal);
+            if beyond <= self.tol * (pb - pa).length() {
+                self.faces[start as usize].conflict.retain(|&i| i != eye);
+                return Ok(());
+            }
+            groups.push(Some(plane));
+        }
+        // The cone of new faces from the eye to every horizon edge.
+        let first = self.faces.len() as u32;
+        for (&(f, i), &group) in horizon.iter().zip(&groups) {
+            let face = &self.faces[f as usize];
+            let (a, b, across) = (face.v[i], face.v[(i + 1) % 3], face.adj[i]);
+            let nf = self.push_face([a, b, eye], group)?;
             let twin = &mut self.faces[across as usize];
             let j = (0..3)
                 .find(|&j| twin.v[j] == b && twin.v[(j + 1) % 3] == a)
@@ -406,7 +508,7 @@ impl<'a> Builder<'a> {
             if mark == stamp {
                 continue;
             }
-            if mark != stamp + 1 && self.faces[nb as usize].distance(p) > self.tol {
+            if mark != stamp + 1 && self.distance(nb, p) > self.tol {
                 self.mark[nb as usize] = stamp;
                 visible.push(nb);
                 let back = (0..3)
@@ -471,7 +573,7 @@ fn initial_simplex(pts: &[Vec3], tol: Real) -> std::result::Result<[u32; 4], Fai
         return Err(degenerate("all points are collinear: no 3D hull exists"));
     }
     let pc = pts[c as usize];
-    let (n, _) = triangle_plane(pa, pb, pc).ok_or(Failure::Numerical)?;
+    let n = triangle_plane(pa, pb, pc).ok_or(Failure::Numerical)?.normal;
     let (d, dist_d) = furthest(&|p| n.dot(p - pa).abs());
     if dist_d <= tol {
         return Err(degenerate("all points are coplanar: no 3D hull exists"));

@@ -9,8 +9,10 @@
 //! 1. Triangles are taken as seeds in order of decreasing area (the largest triangles have the
 //!    best-conditioned planes; ties by index, so the result is deterministic).
 //! 2. A region grows across edges while the new triangle's vertices are within the tolerance
-//!    of the seed plane, the region stays a topological disk (its boundary one simple loop)
-//!    and stays convex (no boundary vertex reflex by more than the tolerance).
+//!    of the seed plane and the region stays a topological disk (its boundary one simple
+//!    loop). If the final polygon is not convex (a boundary vertex reflex by more than the
+//!    tolerance, possible only for nearly coplanar triangles), it is regrown keeping it convex
+//!    at every step.
 //! 3. Vertices shared by only two faces and collinear with their neighbours are removed.
 //! 4. The result is checked to be a closed 2-manifold with `V − E + F = 2`; otherwise the
 //!    caller retries with a larger tolerance.
@@ -32,7 +34,16 @@ pub(super) struct Triangle {
 
 /// Merges the closed triangle mesh `tris` over `pts` into convex polygons (point-index loops,
 /// counter-clockwise from outside), or `None` if the result is not a valid closed polyhedron.
-pub(super) fn merge_triangles(pts: &[Vec3], tris: &[Triangle], tol: Real) -> Option<Vec<Vec<u32>>> {
+///
+/// Also returns the redundant vertices: those reflex or collinear (within `tol`) in a merged
+/// face. They lie within the tolerance of the hull of the other vertices (quickhull never
+/// removes a vertex that later points made redundant), and the caller builds again without
+/// them.
+pub(super) fn merge_triangles(
+    pts: &[Vec3],
+    tris: &[Triangle],
+    tol: Real,
+) -> Option<(Vec<Vec<u32>>, Vec<u32>)> {
     let area: Vec<Real> = tris
         .iter()
         .map(|t| {
@@ -56,16 +67,91 @@ pub(super) fn merge_triangles(pts: &[Vec3], tris: &[Triangle], tol: Real) -> Opt
         vertex_region: vec![NONE; pts.len()],
     };
     let mut polygons = Vec::new();
+    let mut normals = Vec::new();
+    let mut redundant = vec![false; pts.len()];
     for &seed in &order {
         if grower.region[seed as usize] != NONE {
             continue;
         }
         let r = polygons.len() as u32;
-        let members = grower.grow(seed, r);
-        polygons.push(grower.boundary_loop(&members, r)?);
+        // First grow freely (a fan around an interior vertex is only convex once complete);
+        // if the final polygon is not convex, regrow keeping it convex at every step.
+        let members = grower.grow(seed, r, false);
+        let face = grower.boundary_loop(&members, r)?;
+        let normal = tris[seed as usize].normal;
+        normals.push(normal);
+        if mark_redundant(pts, &face, normal, -tol, &mut redundant) == 0 {
+            polygons.push(face);
+        } else {
+            for &m in &members {
+                grower.region[m as usize] = NONE;
+                for v in tris[m as usize].v {
+                    grower.vertex_region[v as usize] = NONE;
+                }
+            }
+            let members = grower.grow(seed, r, true);
+            polygons.push(grower.boundary_loop(&members, r)?);
+        }
     }
     remove_collinear(pts, &mut polygons, tol);
-    is_closed_polyhedron(&polygons).then_some(polygons)
+    for (face, &normal) in polygons.iter().zip(&normals) {
+        mark_redundant(pts, face, normal, tol, &mut redundant);
+    }
+    let redundant = (0..pts.len() as u32)
+        .filter(|&i| redundant[i as usize])
+        .collect();
+    is_closed_polyhedron(&polygons).then_some((polygons, redundant))
+}
+
+/// Signed distance of `v` from the line `u w`, positive where the polygon `… u v w …`
+/// (counter-clockwise about `normal`) is convex at `v`.
+fn turn(pts: &[Vec3], u: u32, v: u32, w: u32, normal: Vec3) -> Real {
+    let [u, v, w] = [u, v, w].map(|i| pts[i as usize]);
+    // Twice the signed area of (u, v, w) = |w − u| · signed distance of v to line uw.
+    let base = (w - u).length();
+    if base > 0.0 {
+        (v - u).cross(w - v).dot(normal) / base
+    } else {
+        0.0
+    }
+}
+
+/// Marks in `removed` the vertices of `face` whose turn is at most `limit`, one at a time:
+/// each removal is taken into account (with the vertices already marked, possibly by other
+/// faces) before judging the next, so of two nearly coincident vertices only one goes.
+/// Returns how many it marked.
+fn mark_redundant(
+    pts: &[Vec3],
+    face: &[u32],
+    normal: Vec3,
+    limit: Real,
+    removed: &mut [bool],
+) -> usize {
+    let mut ring: Vec<u32> = face
+        .iter()
+        .copied()
+        .filter(|&v| !removed[v as usize])
+        .collect();
+    let mut marked = 0;
+    let mut k = 0;
+    let mut unchanged = 0;
+    while ring.len() > 3 && unchanged < ring.len() {
+        let n = ring.len();
+        let (u, v, w) = (ring[(k + n - 1) % n], ring[k % n], ring[(k + 1) % n]);
+        if turn(pts, u, v, w, normal) <= limit {
+            removed[v as usize] = true;
+            marked += 1;
+            let i = k % n;
+            ring.remove(i);
+            // Judge the previous vertex again with its new neighbour.
+            k = (i + n - 2) % (n - 1);
+            unchanged = 0;
+        } else {
+            k = (k + 1) % n;
+            unchanged += 1;
+        }
+    }
+    marked
 }
 
 /// Region-growing state. The boundary of the region being grown is a doubly linked loop over
@@ -83,8 +169,9 @@ struct Grower<'a> {
 }
 
 impl Grower<'_> {
-    /// Grows region `r` from `seed`; returns its triangles.
-    fn grow(&mut self, seed: u32, r: u32) -> Vec<u32> {
+    /// Grows region `r` from `seed`, keeping it convex at every step if `strict`; returns its
+    /// triangles.
+    fn grow(&mut self, seed: u32, r: u32, strict: bool) -> Vec<u32> {
         let t = &self.tris[seed as usize];
         let (normal, offset) = (t.normal, t.offset);
         self.region[seed as usize] = r;
@@ -98,7 +185,7 @@ impl Grower<'_> {
         let mut candidates: Vec<u32> = t.adj.to_vec();
         // A rejected candidate is retried when another of its neighbours joins.
         while let Some(c) = candidates.pop() {
-            if self.region[c as usize] == NONE && self.try_add(c, r, normal, offset) {
+            if self.region[c as usize] == NONE && self.try_add(c, r, normal, offset, strict) {
                 self.region[c as usize] = r;
                 members.push(c);
                 candidates.extend(self.tris[c as usize].adj);
@@ -110,14 +197,12 @@ impl Grower<'_> {
     /// Whether vertex `v` between `u` and `w` is convex (or reflex by at most the tolerance)
     /// seen along `normal`.
     fn convex(&self, u: u32, v: u32, w: u32, normal: Vec3) -> bool {
-        let [u, v, w] = [u, v, w].map(|i| self.pts[i as usize]);
-        // Twice the signed area of (u, v, w) = |w − u| · signed distance of v to line uw.
-        (v - u).cross(w - v).dot(normal) >= -self.tol * (w - u).length()
+        turn(self.pts, u, v, w, normal) >= -self.tol
     }
 
     /// Adds triangle `c` to region `r` (plane `normal · x = offset`) if it is coplanar, keeps
-    /// the region a convex disk, and updates the boundary loop.
-    fn try_add(&mut self, c: u32, r: u32, normal: Vec3, offset: Real) -> bool {
+    /// the region a disk (and convex if `strict`), and updates the boundary loop.
+    fn try_add(&mut self, c: u32, r: u32, normal: Vec3, offset: Real, strict: bool) -> bool {
         let t = &self.tris[c as usize];
         if t.normal.dot(normal) <= 0.0
             || t.v
@@ -137,7 +222,9 @@ impl Grower<'_> {
                     return false; // z already on the region: adding t would pinch it
                 }
                 let (before, after) = (self.prev[y as usize], self.next[x as usize]);
-                if !self.convex(before, y, z, normal) || !self.convex(z, x, after, normal) {
+                if strict
+                    && (!self.convex(before, y, z, normal) || !self.convex(z, x, after, normal))
+                {
                     return false;
                 }
                 self.next[y as usize] = z;
@@ -155,7 +242,9 @@ impl Grower<'_> {
                     return false;
                 }
                 let (before, after) = (self.prev[z as usize], self.next[x as usize]);
-                if !self.convex(before, z, x, normal) || !self.convex(z, x, after, normal) {
+                if strict
+                    && (!self.convex(before, z, x, normal) || !self.convex(z, x, after, normal))
+                {
                     return false;
                 }
                 self.next[z as usize] = x;

@@ -6,7 +6,8 @@ use carom_collision::shape::HullPolygons;
 use carom_collision::{CaromError, Result};
 
 /// Brute-force hull of `points`: every plane through three points that has all points on one
-/// side (within `1e-5 ×` the largest coordinate), each face polygon by Andrew's monotone chain.
+/// side (within `1e-5 ×` the largest coordinate), one per set of points on it, each face
+/// polygon by Andrew's monotone chain.
 /// O(n⁴); the test oracle for quickhull.
 pub fn brute_force_hull(points: &[Vec3]) -> Result<HullPolygons> {
     if points.len() < 4 {
@@ -23,6 +24,9 @@ pub fn brute_force_hull(points: &[Vec3]) -> Result<HullPolygons> {
     let eps = scale * 1e-5;
     let n = points.len();
     let mut planes: Vec<(Vec3, Real)> = Vec::new();
+    // A face is identified by the set of points on its plane (not by its normal, which is
+    // ill-defined for nearly coplanar points).
+    let mut on_sets: Vec<Vec<usize>> = Vec::new();
     for i in 0..n {
         for j in i + 1..n {
             for k in j + 1..n {
@@ -43,10 +47,11 @@ pub fn brute_force_hull(points: &[Vec3]) -> Result<HullPolygons> {
                     (true, false) => (-nrm, -d),
                     _ => continue,
                 };
-                if !planes
-                    .iter()
-                    .any(|(m, o)| (*m - plane.0).length() < 1e-4 && (o - plane.1).abs() < eps)
-                {
+                let on: Vec<usize> = (0..n)
+                    .filter(|&l| (plane.0.dot(points[l]) - plane.1).abs() <= eps)
+                    .collect();
+                if !on_sets.contains(&on) {
+                    on_sets.push(on);
                     planes.push(plane);
                 }
             }
