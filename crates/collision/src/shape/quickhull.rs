@@ -77,7 +77,7 @@ pub fn quickhull(points: &[Vec3]) -> Result<HullPolygons> {
     let mut last = None;
     for _ in 0..MAX_ROUNDS {
         let subset: Vec<Vec3> = active.iter().map(|&i| local[i as usize]).collect();
-        let (faces, redundant) = match build_with_retries(&subset, base_tol, flat_tol) {
+        let (faces, redundant, vertices) = match build_with_retries(&subset, base_tol, flat_tol) {
             Ok(built) => built,
             Err(e) => return last.map(|faces| reindex(points, faces)).ok_or(e),
         };
@@ -90,8 +90,12 @@ pub fn quickhull(points: &[Vec3]) -> Result<HullPolygons> {
         }
         // Hull vertices that lie within the tolerance of the hull of the others (reflex or
         // collinear in a face): build again without them.
-        let redundant: Vec<u32> = redundant.iter().map(|&i| active[i as usize]).collect();
-        active.retain(|i| !redundant.contains(i));
+        // Points off the triangle hull are within the tolerance of it, and stay so.
+        active = vertices
+            .into_iter()
+            .filter(|i| redundant.binary_search(i).is_err())
+            .map(|i| active[i as usize])
+            .collect();
         last = Some(faces);
     }
     Ok(reindex(points, last.unwrap_or_default()))
@@ -101,12 +105,8 @@ pub fn quickhull(points: &[Vec3]) -> Result<HullPolygons> {
 const MAX_ROUNDS: usize = 8;
 
 /// Builds the hull of `pts`, retrying with larger tolerances when rounding makes a build
-/// inconsistent. Returns the polygons and the redundant vertices found (see `build`).
-fn build_with_retries(
-    pts: &[Vec3],
-    base_tol: Real,
-    flat_tol: Real,
-) -> Result<(Vec<Vec<u32>>, Vec<u32>)> {
+/// inconsistent. Returns what `build` does.
+fn build_with_retries(pts: &[Vec3], base_tol: Real, flat_tol: Real) -> Result<Built> {
     for scale in TOLERANCE_SCALES {
         match build(pts, base_tol * scale, flat_tol) {
             Ok(built) => return Ok(built),
@@ -180,8 +180,9 @@ fn reindex(points: &[Vec3], faces: Vec<Vec<u32>>) -> HullPolygons {
     HullPolygons { vertices, faces }
 }
 
-/// A hull as polygons over point indices, and the redundant vertices found while merging.
-type Built = (Vec<Vec<u32>>, Vec<u32>);
+/// A hull as polygons over point indices, the redundant vertices found while merging, and
+/// the vertices of the triangle hull (sorted).
+type Built = (Vec<Vec<u32>>, Vec<u32>, Vec<u32>);
 
 /// One build attempt at tolerance `tol`: polygons over point indices, and the hull vertices
 /// found redundant (see `merge_triangles`). Inputs thinner than `flat_tol` are rejected as
@@ -242,5 +243,10 @@ fn build(pts: &[Vec3], tol: Real, flat_tol: Real) -> std::result::Result<Built, 
     if triangles.iter().any(|t| t.adj.contains(&NONE)) {
         return Err(Failure::Numerical);
     }
-    merge_triangles(pts, &triangles, 2.0 * tol).ok_or(Failure::Numerical)
+    let (polygons, redundant) =
+        merge_triangles(pts, &triangles, 2.0 * tol).ok_or(Failure::Numerical)?;
+    let mut vertices: Vec<u32> = triangles.iter().flat_map(|t| t.v).collect();
+    vertices.sort_unstable();
+    vertices.dedup();
+    Ok((polygons, redundant, vertices))
 }

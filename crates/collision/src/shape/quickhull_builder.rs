@@ -112,6 +112,18 @@ impl<'a> Builder<'a> {
         Ok(hull)
     }
 
+    /// Whether `p`, known to be within the tolerance of the plane of face `f`, lies within the
+    /// triangle (up to the tolerance) seen along its normal.
+    fn on_face(&self, f: u32, p: Vec3) -> bool {
+        let face = &self.faces[f as usize];
+        let normal = self.planes[face.plane as usize].normal;
+        (0..3).all(|k| {
+            let u = self.pts[face.v[k] as usize];
+            let v = self.pts[face.v[(k + 1) % 3] as usize];
+            (v - u).cross(p - u).dot(normal) >= -self.tol * (v - u).length()
+        })
+    }
+
     /// Signed distance of `p` above the plane of face `f`.
     pub(super) fn distance(&self, f: u32, p: Vec3) -> Real {
         let plane = &self.planes[self.faces[f as usize].plane as usize];
@@ -197,8 +209,8 @@ impl<'a> Builder<'a> {
             self.on_horizon[end as usize] = self.stamp;
         }
         // A new face coplanar with the face across its horizon edge shares that face's plane.
-        // If the eye is coplanar with that face but not clearly beyond the edge, it lies on
-        // the hull (it only looked visible through a poorly conditioned plane): drop it.
+        // If the eye is coplanar with that face but not clearly beyond the edge, it should lie
+        // on that face (it only looked visible through a poorly conditioned plane): drop it.
         let mut groups = Vec::with_capacity(m);
         for &(f, i) in &horizon {
             let face = &self.faces[f as usize];
@@ -213,6 +225,11 @@ impl<'a> Builder<'a> {
                 .cross(p - pa)
                 .dot(self.planes[plane as usize].normal);
             if beyond <= self.tol * (pb - pa).length() {
+                if !self.on_face(across, p) {
+                    // Coplanar with `across` yet beyond one of its other edges: rounding has
+                    // made the hull locally inconsistent.
+                    return Err(Failure::Numerical);
+                }
                 self.faces[start as usize].conflict.retain(|&i| i != eye);
                 return Ok(());
             }
