@@ -5,7 +5,7 @@ use super::quickhull::{quickhull, HullPolygons};
 use super::support::SupportMap;
 use super::MassProperties;
 use crate::error::Result;
-use crate::math::{check_finite_vec, Aabb, Real, Vec3};
+use crate::math::{check_finite_vec, Aabb, Mat3, Real, Vec3};
 use serde::{Deserialize, Serialize};
 
 /// One polygonal face of a hull: a plane and a counter-clockwise (seen from outside) loop of
@@ -26,19 +26,30 @@ pub struct HullFace {
 /// triangles merged), unique edges and a triangulation.
 ///
 /// Its margin is zero: the core is the hull itself, so `support` and `support_core` agree.
+///
+/// It also stores each vertex's neighbours along the edges, for hill-climbing support queries
+/// (above [`ConvexHull::HILL_CLIMB_MIN_VERTICES`] vertices) and later for contact generation.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ConvexHull {
     vertices: Vec<Vec3>,
     faces: Vec<HullFace>,
     face_vertex_indices: Vec<u32>,
     edges: Vec<[u32; 2]>,
+    /// Vertex `v`'s neighbours are `neighbors[neighbor_offsets[v]..neighbor_offsets[v + 1]]`.
+    neighbor_offsets: Vec<u32>,
+    neighbors: Vec<u32>,
     triangles: Vec<[u32; 3]>,
     local_aabb: Aabb,
     volume: Real,
-    unit_mass: MassProperties,
+    /// Boxed to keep `Shape` small.
+    unit_mass: Box<MassProperties>,
 }
 
 impl ConvexHull {
+    /// Hulls with more vertices than this answer support queries by hill climbing over the
+    /// vertex adjacency; smaller ones scan all vertices.
+    pub const HILL_CLIMB_MIN_VERTICES: usize = 32;
+
     /// The convex hull of `points` (quickhull). Duplicate, coplanar and interior points are
     /// handled; at least 4 points are needed and they must span a 3D volume, else a
     /// [`crate::CaromError`] says why (too few, collinear, coplanar, or NaN).
@@ -58,24 +69,28 @@ impl ConvexHull {
         let mut triangles = Vec::new();
         let mut edges = Vec::new();
         for poly in &faces {
-            // Newell's method: a robust normal for a planar polygon.
+            // The normal: the corner cross products (v_k − v_{k−1}) × (v_{k+1} − v_k) all point
+            // along it for a convex polygon. Built from edge vectors (differences of nearby
+            // floats, exact) rather than positions as in Newell's method, and weighted by the
+            // sine of the corner angle, it stays accurate far from the origin and for slivers,
+            // where corners between two long, nearly parallel edges carry large relative
+            // rounding errors.
+            let count = poly.len();
+            let at = |k: usize| vertices[poly[k % count] as usize];
             let mut n = Vec3::ZERO;
-            let mut centroid = Vec3::ZERO;
-            for (k, &i) in poly.iter().enumerate() {
-                let p = vertices[i as usize];
-                let q = vertices[poly[(k + 1) % poly.len()] as usize];
-                n += Vec3::new(
-                    (p.y - q.y) * (p.z + q.z),
-                    (p.z - q.z) * (p.x + q.x),
-                    (p.x - q.x) * (p.y + q.y),
-                );
-                centroid += p;
+            for k in 0..count {
+                let (e1, e2) = (at(k) - at(k + count - 1), at(k + 1) - at(k));
+                let corner = e1.cross(e2);
+                let lengths = e1.length() * e2.length();
+                if lengths > 0.0 {
+                    n += corner * (corner.length() / lengths);
+                }
             }
-            centroid /= poly.len() as Real;
             let normal = n.normalize_or_zero();
+            let offset = (0..count).map(|k| normal.dot(at(k))).sum::<Real>() / count as Real;
             hull_faces.push(HullFace {
                 normal,
-                offset: normal.dot(centroid),
+                offset,
                 first: face_vertex_indices.len() as u32,
                 count: poly.len() as u32,
             });
@@ -92,17 +107,20 @@ impl ConvexHull {
         }
         edges.sort_unstable();
         edges.dedup();
-        let (volume, unit_mass) = polyhedron_mass_properties(&vertices, &triangles);
+        let (neighbor_offsets, neighbors) = vertex_adjacency(vertices.len(), &edges);
         let local_aabb = Aabb::from_points(vertices.iter().copied());
+        let (volume, unit_mass) = scaled_mass_properties(&vertices, &triangles, &local_aabb);
         ConvexHull {
             vertices,
             faces: hull_faces,
             face_vertex_indices,
             edges,
+            neighbor_offsets,
+            neighbors,
             triangles,
             local_aabb,
             volume,
-            unit_mass,
+            unit_mass: Box::new(unit_mass),
         }
     }
 
@@ -133,6 +151,55 @@ impl ConvexHull {
         &self.edges
     }
 
+    /// The vertices joined to vertex `v` by an edge, in increasing order.
+    pub fn vertex_neighbors(&self, v: usize) -> &[u32] {
+        &self.neighbors[self.neighbor_offsets[v] as usize..self.neighbor_offsets[v + 1] as usize]
+    }
+
+    /// Index of a vertex maximising `vertex · dir` (the support vertex).
+    ///
+    /// Above [`ConvexHull::HILL_CLIMB_MIN_VERTICES`] vertices it hill-climbs along the edges from vertex 0,
+    /// moving to the best neighbour while that improves the dot product: on a convex polyhedron
+    /// a vertex no neighbour improves on is a global maximum (the vertex-adjacency walk of
+    /// Bullet's `btConvexHullComputer`-based shapes and Jolt's `ConvexHullShape`). Each step
+    /// strictly increases the dot product, so it ends; it is also capped at the vertex count.
+    /// Below the threshold a linear scan is faster. A zero or NaN `dir` gives vertex 0.
+    pub fn support_vertex(&self, dir: Vec3) -> usize {
+        if self.vertices.len() <= Self::HILL_CLIMB_MIN_VERTICES {
+            return self.support_vertex_scan(dir);
+        }
+        let mut best = 0;
+        let mut best_dot = self.vertices[0].dot(dir);
+        for _ in 0..self.vertices.len() {
+            let current = best;
+            for &n in self.vertex_neighbors(current) {
+                let d = self.vertices[n as usize].dot(dir);
+                if d > best_dot {
+                    best = n as usize;
+                    best_dot = d;
+                }
+            }
+            if best == current {
+                break;
+            }
+        }
+        best
+    }
+
+    /// [`Self::support_vertex`] by scanning every vertex.
+    fn support_vertex_scan(&self, dir: Vec3) -> usize {
+        let mut best = 0;
+        let mut best_dot = self.vertices[0].dot(dir);
+        for (i, v) in self.vertices.iter().enumerate().skip(1) {
+            let d = v.dot(dir);
+            if d > best_dot {
+                best_dot = d;
+                best = i;
+            }
+        }
+        best
+    }
+
     /// A triangulation of the faces (fans), counter-clockwise from outside.
     pub fn triangles(&self) -> &[[u32; 3]] {
         &self.triangles
@@ -161,16 +228,7 @@ impl ConvexHull {
 impl SupportMap for ConvexHull {
     #[inline]
     fn support(&self, dir: Vec3) -> Vec3 {
-        let mut best = self.vertices[0];
-        let mut best_dot = best.dot(dir);
-        for v in &self.vertices[1..] {
-            let d = v.dot(dir);
-            if d > best_dot {
-                best_dot = d;
-                best = *v;
-            }
-        }
-        best
+        self.vertices[self.support_vertex(dir)]
     }
     #[inline]
     fn support_core(&self, dir: Vec3) -> Vec3 {
@@ -180,4 +238,57 @@ impl SupportMap for ConvexHull {
     fn margin(&self) -> Real {
         0.0
     }
+}
+
+/// Compressed vertex adjacency (offsets, neighbour lists sorted by index) from unique edges.
+fn vertex_adjacency(vertex_count: usize, edges: &[[u32; 2]]) -> (Vec<u32>, Vec<u32>) {
+    let mut offsets = vec![0u32; vertex_count + 1];
+    for &[a, b] in edges {
+        offsets[a as usize + 1] += 1;
+        offsets[b as usize + 1] += 1;
+    }
+    for i in 0..vertex_count {
+        offsets[i + 1] += offsets[i];
+    }
+    let mut fill = offsets.clone();
+    let mut neighbors = vec![0u32; 2 * edges.len()];
+    for &[a, b] in edges {
+        neighbors[fill[a as usize] as usize] = b;
+        fill[a as usize] += 1;
+        neighbors[fill[b as usize] as usize] = a;
+        fill[b as usize] += 1;
+    }
+    for v in 0..vertex_count {
+        neighbors[offsets[v] as usize..offsets[v + 1] as usize].sort_unstable();
+    }
+    (offsets, neighbors)
+}
+
+/// [`polyhedron_mass_properties`] computed on the hull moved to the centre of its bounding box
+/// and scaled to unit size by a power of two (exact), then mapped back: volume × s³, centre
+/// × s + shift, inertia × s⁵. This keeps tiny, huge and far-from-origin hulls accurate (the
+/// mass routine's flatness threshold is absolute).
+fn scaled_mass_properties(
+    vertices: &[Vec3],
+    triangles: &[[u32; 3]],
+    aabb: &Aabb,
+) -> (Real, MassProperties) {
+    let centre = aabb.center();
+    let extent = aabb.half_extents().max_element();
+    let scale = (2.0 as Real).powi(extent.log2().ceil() as i32);
+    if !(scale.is_finite() && scale > 0.0) {
+        return polyhedron_mass_properties(vertices, triangles);
+    }
+    let local: Vec<Vec3> = vertices.iter().map(|v| (*v - centre) / scale).collect();
+    let (volume, unit) = polyhedron_mass_properties(&local, triangles);
+    let s3 = scale * scale * scale;
+    let inertia: Mat3 = unit.inertia * (s3 * scale * scale);
+    (
+        volume * s3,
+        MassProperties {
+            mass: unit.mass * s3,
+            center_of_mass: unit.center_of_mass * scale + centre,
+            inertia,
+        },
+    )
 }

@@ -14,6 +14,8 @@ mod cylinder;
 mod mass;
 mod plane;
 mod quickhull;
+mod quickhull_builder;
+mod quickhull_merge;
 mod scaled;
 mod sphere;
 mod support;
