@@ -488,7 +488,7 @@ mod tests {
         for (body, cell) in s.bodies.iter().skip(1).zip(data::halton_cells()) {
             let v = body.shape.volume() as f64;
             assert!(
-                (v - cell.volume).abs() < 5e-3 * cell.volume,
+                (v - cell.volume).abs() < 1e-4 * cell.volume,
                 "{}: hull volume {v} vs {}",
                 cell.name,
                 cell.volume

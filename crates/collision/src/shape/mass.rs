@@ -122,7 +122,11 @@ pub fn polyhedron_mass_properties(
         first += (a + b + c) * (det / 24.0);
         cov += m * c0 * m.transpose() * det;
     }
-    if volume.abs() <= Real::EPSILON * 1e3 * (1.0 + first.length()) || !volume.is_finite() {
+    // Flat (or empty) solids: the volume is rounding noise relative to the mesh's size cubed.
+    let size = vertices
+        .iter()
+        .fold(0.0 as Real, |m, v| m.max((*v - shift).abs().max_element()));
+    if !volume.is_finite() || volume.abs() <= 64.0 * Real::EPSILON * size * size * size {
         return (0.0, MassProperties::ZERO);
     }
     let com = first / volume;
@@ -210,5 +214,45 @@ mod tests {
         assert_eq!(s.mass, 2.0);
         assert!(s.center_of_mass.length() < 1e-6);
         assert!((s.inertia.y_axis.y - 2.0).abs() < 1e-6 && s.inertia.x_axis.x.abs() < 1e-6);
+    }
+}
+
+#[cfg(test)]
+mod small_scale_tests {
+    use super::*;
+
+    /// Regression: a volume threshold in absolute units zeroed small solids (a 1 cm cube).
+    #[test]
+    fn tiny_cube_keeps_its_volume() {
+        let s: Real = 0.01;
+        let v: Vec<Vec3> = (0..8)
+            .map(|i| {
+                Vec3::new(
+                    (i & 1) as Real,
+                    ((i >> 1) & 1) as Real,
+                    ((i >> 2) & 1) as Real,
+                ) * s
+            })
+            .collect();
+        let t = [
+            [0, 2, 1],
+            [1, 2, 3],
+            [4, 5, 6],
+            [5, 7, 6],
+            [0, 1, 4],
+            [1, 5, 4],
+            [2, 6, 3],
+            [3, 6, 7],
+            [0, 4, 2],
+            [2, 4, 6],
+            [1, 3, 5],
+            [3, 7, 5],
+        ];
+        let (vol, mp) = polyhedron_mass_properties(&v, &t);
+        assert!((vol - 1e-6).abs() < 1e-9, "volume {vol}");
+        assert!((mp.center_of_mass - Vec3::splat(0.005)).length() < 1e-6);
+        // A flat mesh still has no volume.
+        let flat: Vec<Vec3> = v.iter().map(|p| Vec3::new(p.x, p.y, 0.0)).collect();
+        assert_eq!(polyhedron_mass_properties(&flat, &t).0, 0.0);
     }
 }
