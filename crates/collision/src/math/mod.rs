@@ -63,6 +63,7 @@ pub fn vec3_from_f64(v: [f64; 3]) -> Vec3 {
 
 /// Converts a [`Vec3`] to `[f64; 3]`.
 #[inline]
+#[allow(clippy::unnecessary_cast)] // a no-op in the f64 build
 pub fn vec3_to_f64(v: Vec3) -> [f64; 3] {
     [v.x as f64, v.y as f64, v.z as f64]
 }
