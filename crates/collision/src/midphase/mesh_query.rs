@@ -6,7 +6,7 @@
 //! broken by the smaller triangle index, so results do not depend on the visit order).
 
 use super::bvh::Bvh;
-use super::triangle_query::{closest_point_on_triangle, ray_triangle};
+use super::triangle_query::{closest_point_on_triangle, WatertightRay};
 use crate::math::{Aabb, Isometry, Real, Vec3};
 
 /// A ray hit on a mesh.
@@ -63,21 +63,28 @@ pub fn triangle_aabbs(vertices: &[Vec3], indices: &[[u32; 3]]) -> Vec<Aabb> {
         .collect()
 }
 
+/// The prepared ray, or `None` for an invalid ray (non-finite, zero direction, NaN or
+/// negative `max_t`).
 #[inline]
-fn valid_ray(origin: Vec3, dir: Vec3, max_t: Real) -> bool {
-    origin.is_finite() && dir.is_finite() && dir != Vec3::ZERO && max_t >= 0.0
+fn prepared(origin: Vec3, dir: Vec3, max_t: Real) -> Option<WatertightRay> {
+    if max_t >= 0.0 {
+        WatertightRay::new(origin, dir)
+    } else {
+        None
+    }
 }
 
 /// Leaf ray test shared by the BVH and brute-force paths.
 #[inline]
 fn ray_hit(
+    ray: &WatertightRay,
     tri: &[Vec3; 3],
     index: u32,
     origin: Vec3,
     dir: Vec3,
     max_t: Real,
 ) -> Option<MeshRayHit> {
-    let h = ray_triangle(origin, dir, max_t, tri)?;
+    let h = ray.intersect(tri, max_t)?;
     let normal = (tri[1] - tri[0])
         .cross(tri[2] - tri[0])
         .try_normalize()
@@ -137,13 +144,11 @@ impl<'a> MeshView<'a> {
 
     /// The closest hit of the ray `origin + t·dir`, `t ∈ [0, max_t]`.
     pub fn ray_closest(&self, origin: Vec3, dir: Vec3, max_t: Real) -> Option<MeshRayHit> {
-        if !valid_ray(origin, dir, max_t) {
-            return None;
-        }
+        let ray = prepared(origin, dir, max_t)?;
         let mut best: Option<MeshRayHit> = None;
         self.bvh
-            .for_each_candidate_on_ray(origin, dir, max_t, |i, limit| {
-                if let Some(h) = ray_hit(&self.triangle(i), i, origin, dir, *limit) {
+            .for_each_candidate_on_ray_ordered(origin, dir, max_t, |i, limit| {
+                if let Some(h) = ray_hit(&ray, &self.triangle(i), i, origin, dir, *limit) {
                     if better(h.t, i, best.map(|b| (b.t, b.triangle))) {
                         *limit = h.t;
                         best = Some(h);
@@ -156,13 +161,11 @@ impl<'a> MeshView<'a> {
 
     /// Some hit of the ray (the first found), for occlusion tests.
     pub fn ray_any(&self, origin: Vec3, dir: Vec3, max_t: Real) -> Option<MeshRayHit> {
-        if !valid_ray(origin, dir, max_t) {
-            return None;
-        }
+        let ray = prepared(origin, dir, max_t)?;
         let mut found = None;
         self.bvh
             .for_each_candidate_on_ray(origin, dir, max_t, |i, limit| {
-                found = ray_hit(&self.triangle(i), i, origin, dir, *limit);
+                found = ray_hit(&ray, &self.triangle(i), i, origin, dir, *limit);
                 found.is_none()
             });
         found
@@ -170,13 +173,13 @@ impl<'a> MeshView<'a> {
 
     /// Every hit of the ray, appended to `out` sorted by `(t, triangle)`.
     pub fn ray_all(&self, origin: Vec3, dir: Vec3, max_t: Real, out: &mut Vec<MeshRayHit>) {
-        if !valid_ray(origin, dir, max_t) {
+        let Some(ray) = prepared(origin, dir, max_t) else {
             return;
-        }
+        };
         let start = out.len();
         self.bvh
             .for_each_candidate_on_ray(origin, dir, max_t, |i, limit| {
-                if let Some(h) = ray_hit(&self.triangle(i), i, origin, dir, *limit) {
+                if let Some(h) = ray_hit(&ray, &self.triangle(i), i, origin, dir, *limit) {
                     out.push(h);
                 }
                 true
@@ -249,11 +252,11 @@ pub mod brute_force {
 
     /// Every hit, sorted by `(t, triangle)`.
     pub fn ray_all(m: &MeshView, origin: Vec3, dir: Vec3, max_t: Real) -> Vec<MeshRayHit> {
-        if !valid_ray(origin, dir, max_t) {
+        let Some(ray) = prepared(origin, dir, max_t) else {
             return Vec::new();
-        }
+        };
         let mut hits: Vec<MeshRayHit> = (0..m.indices.len() as u32)
-            .filter_map(|i| ray_hit(&m.triangle(i), i, origin, dir, max_t))
+            .filter_map(|i| ray_hit(&ray, &m.triangle(i), i, origin, dir, max_t))
             .collect();
         sort_hits(&mut hits);
         hits

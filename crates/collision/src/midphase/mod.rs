@@ -17,4 +17,4 @@ mod triangle_query;
 pub use build::{MAX_LEAF_SIZE, NUM_BINS};
 pub use bvh::{Bvh, BvhLayout, Quantization, QuantizedNode, UnquantizedNode, MAX_PRIMITIVES};
 pub use mesh_query::{brute_force, triangle_aabbs, MeshPointProjection, MeshRayHit, MeshView};
-pub use triangle_query::{closest_point_on_triangle, ray_triangle, TriangleRayHit};
+pub use triangle_query::{closest_point_on_triangle, ray_triangle, TriangleRayHit, WatertightRay};

@@ -11,7 +11,7 @@
 //! the exit distance is scaled by `1 + 2γ₃` so a ray touching a box is never culled.
 
 use super::bvh::{leaf_range, Bvh, Nodes, Quantization, QuantizedNode, UnquantizedNode, LEAF_FLAG};
-use crate::math::{Aabb, Real, Vec3, EPSILON};
+use crate::math::{Aabb, Real, Vec3, Vec3A, EPSILON};
 
 /// `1 + 2γ₃` with `γₙ = nε / (1 - nε)` (Ize 2013), plus slack for the quantised mapping and
 /// for the rounding of the leaf test's `t`, so a box is never culled against a tied hit.
@@ -20,30 +20,41 @@ const ROBUST_EXIT: Real = 1.0 + 2.0 * (3.0 * EPSILON / (1.0 - 3.0 * EPSILON)) + 
 /// A ray prepared for slab tests against the boxes of one layout.
 #[derive(Clone, Copy)]
 pub(crate) struct PreparedRay {
-    lo: Vec3,
-    hi: Vec3,
-    inv: Vec3,
+    lo: Vec3A,
+    hi: Vec3A,
+    inv: Vec3A,
 }
 
 impl PreparedRay {
     #[inline]
     fn new(origin: Vec3, dir: Vec3, pad: Vec3) -> Self {
         PreparedRay {
-            lo: -pad - origin,
-            hi: pad - origin,
-            inv: dir.recip(),
+            lo: Vec3A::from(-pad - origin),
+            hi: Vec3A::from(pad - origin),
+            inv: Vec3A::from(dir.recip()),
         }
     }
 
     /// True when the ray meets the box `[min, max]` (in the prepared frame) within
     /// `[0, max_t]`.
     #[inline(always)]
-    fn hits(&self, min: Vec3, max: Vec3, max_t: Real) -> bool {
+    fn hits(&self, min: Vec3A, max: Vec3A, max_t: Real) -> bool {
+        self.entry(min, max, max_t) <= max_t * ROBUST_EXIT
+    }
+
+    /// Entry parameter of the ray into the box (clamped to 0), or infinity when it misses
+    /// the box within `[0, max_t]`.
+    #[inline(always)]
+    fn entry(&self, min: Vec3A, max: Vec3A, max_t: Real) -> Real {
         let t1 = (min + self.lo) * self.inv;
         let t2 = (max + self.hi) * self.inv;
         let near = t1.min(t2).max_element().max(0.0);
         let far = t1.max(t2).min_element().min(max_t) * ROBUST_EXIT;
-        near <= far
+        if near <= far {
+            near
+        } else {
+            Real::INFINITY
+        }
     }
 }
 
@@ -59,14 +70,16 @@ pub(crate) trait NodeSet {
     fn overlaps(&self, i: usize, q: &Self::BoxQuery) -> bool;
     fn ray(&self, origin: Vec3, dir: Vec3) -> PreparedRay;
     fn ray_hits(&self, i: usize, r: &PreparedRay, max_t: Real) -> bool;
+    /// Entry parameter into node `i`'s box, infinity on a miss.
+    fn ray_entry(&self, i: usize, r: &PreparedRay, max_t: Real) -> Real;
 }
 
 /// Quantised nodes with their quantisation.
 pub(crate) struct QNodes<'a>(pub &'a [QuantizedNode], pub &'a Quantization);
 
 #[inline(always)]
-fn u16v(v: [u16; 3]) -> Vec3 {
-    Vec3::new(v[0] as Real, v[1] as Real, v[2] as Real)
+fn u16v(v: [u16; 3]) -> Vec3A {
+    Vec3A::new(v[0] as Real, v[1] as Real, v[2] as Real)
 }
 
 impl NodeSet for QNodes<'_> {
@@ -110,6 +123,11 @@ impl NodeSet for QNodes<'_> {
         let n = &self.0[i];
         r.hits(u16v(n.min), u16v(n.max), max_t)
     }
+    #[inline(always)]
+    fn ray_entry(&self, i: usize, r: &PreparedRay, max_t: Real) -> Real {
+        let n = &self.0[i];
+        r.entry(u16v(n.min), u16v(n.max), max_t)
+    }
 }
 
 impl NodeSet for &[UnquantizedNode] {
@@ -137,7 +155,19 @@ impl NodeSet for &[UnquantizedNode] {
     }
     #[inline(always)]
     fn ray_hits(&self, i: usize, r: &PreparedRay, max_t: Real) -> bool {
-        r.hits(Vec3::from(self[i].min), Vec3::from(self[i].max), max_t)
+        r.hits(
+            Vec3A::from_array(self[i].min),
+            Vec3A::from_array(self[i].max),
+            max_t,
+        )
+    }
+    #[inline(always)]
+    fn ray_entry(&self, i: usize, r: &PreparedRay, max_t: Real) -> Real {
+        r.entry(
+            Vec3A::from_array(self[i].min),
+            Vec3A::from_array(self[i].max),
+            max_t,
+        )
     }
 }
 
@@ -241,6 +271,60 @@ impl Bvh {
                 } else {
                     i = data as usize;
                 }
+            }
+        })
+    }
+
+    /// Like [`Bvh::for_each_candidate_on_ray`], but visits the nearer child first and skips
+    /// subtrees entered beyond the current `max_t`: the fast path for closest hits. Uses a
+    /// small stack of deferred far children (the stackless walk cannot order children).
+    pub fn for_each_candidate_on_ray_ordered(
+        &self,
+        origin: Vec3,
+        dir: Vec3,
+        max_t: Real,
+        mut f: impl FnMut(u32, &mut Real) -> bool,
+    ) {
+        let mut max_t = max_t;
+        with_nodes!(self, ns => {
+            let r = ns.ray(origin, dir);
+            if ns.ray_entry(0, &r, max_t) == Real::INFINITY {
+                return;
+            }
+            let mut stack: Vec<(u32, Real)> = Vec::with_capacity(64);
+            let mut node = 0usize;
+            loop {
+                let data = ns.data(node);
+                let mut next = None;
+                if data & LEAF_FLAG != 0 {
+                    let (first, count) = leaf_range(data);
+                    for &p in &self.order[first..first + count] {
+                        if !f(p, &mut max_t) {
+                            return;
+                        }
+                    }
+                } else {
+                    let (l, rc) = (node + 1, right_child_of(&ns, node));
+                    let tl = ns.ray_entry(l, &r, max_t);
+                    let tr = ns.ray_entry(rc, &r, max_t);
+                    let (near, far, t_far) = if tl <= tr { (l, rc, tr) } else { (rc, l, tl) };
+                    if tl.min(tr) < Real::INFINITY {
+                        next = Some(near);
+                        if t_far < Real::INFINITY {
+                            stack.push((far as u32, t_far));
+                        }
+                    }
+                }
+                node = match next {
+                    Some(n) => n,
+                    None => loop {
+                        match stack.pop() {
+                            Some((n, t)) if t <= max_t * ROBUST_EXIT => break n as usize,
+                            Some(_) => continue,
+                            None => return,
+                        }
+                    },
+                };
             }
         })
     }

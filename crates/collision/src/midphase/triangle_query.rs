@@ -26,63 +26,89 @@ pub fn ray_triangle(
     max_t: Real,
     tri: &[Vec3; 3],
 ) -> Option<TriangleRayHit> {
-    // Axis of the largest direction component becomes z; swap x, y to keep winding.
-    let ad = dir.abs();
-    let kz = if ad.x >= ad.y && ad.x >= ad.z {
-        0
-    } else if ad.y >= ad.z {
-        1
-    } else {
-        2
-    };
-    let mut kx = (kz + 1) % 3;
-    let mut ky = (kx + 1) % 3;
-    if dir[kz] < 0.0 {
-        std::mem::swap(&mut kx, &mut ky);
+    WatertightRay::new(origin, dir)?.intersect(tri, max_t)
+}
+
+/// A ray prepared once for [`ray_triangle`]'s test against many triangles: the permuted
+/// axes and the shear constants.
+#[derive(Debug, Clone, Copy)]
+pub struct WatertightRay {
+    origin: Vec3,
+    k: [usize; 3],
+    shear: Vec3,
+}
+
+impl WatertightRay {
+    /// Prepares the ray; `None` for a zero or non-finite direction.
+    #[inline]
+    pub fn new(origin: Vec3, dir: Vec3) -> Option<Self> {
+        // Axis of the largest direction component becomes z; swap x, y to keep winding.
+        let ad = dir.abs();
+        let kz = if ad.x >= ad.y && ad.x >= ad.z {
+            0
+        } else if ad.y >= ad.z {
+            1
+        } else {
+            2
+        };
+        let mut kx = (kz + 1) % 3;
+        let mut ky = (kx + 1) % 3;
+        if dir[kz] < 0.0 {
+            std::mem::swap(&mut kx, &mut ky);
+        }
+        let dz = dir[kz];
+        if dz == 0.0 || !dir.is_finite() || !origin.is_finite() {
+            return None;
+        }
+        Some(WatertightRay {
+            origin,
+            k: [kx, ky, kz],
+            shear: Vec3::new(dir[kx] / dz, dir[ky] / dz, 1.0 / dz),
+        })
     }
-    let dz = dir[kz];
-    if dz == 0.0 || !dz.is_finite() {
-        return None;
+
+    /// The hit on `tri` with `t ∈ [0, max_t]`, if any.
+    #[inline]
+    pub fn intersect(&self, tri: &[Vec3; 3], max_t: Real) -> Option<TriangleRayHit> {
+        let [kx, ky, kz] = self.k;
+        let (sx, sy, sz) = (self.shear.x, self.shear.y, self.shear.z);
+        let a = tri[0] - self.origin;
+        let b = tri[1] - self.origin;
+        let c = tri[2] - self.origin;
+        let (ax, ay) = (a[kx] - sx * a[kz], a[ky] - sy * a[kz]);
+        let (bx, by) = (b[kx] - sx * b[kz], b[ky] - sy * b[kz]);
+        let (cx, cy) = (c[kx] - sx * c[kz], c[ky] - sy * c[kz]);
+        let u = cx * by - cy * bx;
+        let v = ax * cy - ay * cx;
+        let w = bx * ay - by * ax;
+        if (u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0) {
+            return None;
+        }
+        let det = u + v + w;
+        if det == 0.0 || !det.is_finite() {
+            return None;
+        }
+        let t_scaled = u * (sz * a[kz]) + v * (sz * b[kz]) + w * (sz * c[kz]);
+        // Range check before dividing, with det's sign folded in.
+        let (ts, ds) = if det < 0.0 {
+            (-t_scaled, -det)
+        } else {
+            (t_scaled, det)
+        };
+        if ts < 0.0 || ts > max_t * ds {
+            return None;
+        }
+        let inv = 1.0 / det;
+        let t = t_scaled * inv;
+        let bary = [u * inv, v * inv, w * inv];
+        if !(t.is_finite() && bary.iter().all(|x| x.is_finite())) || t > max_t {
+            return None;
+        }
+        Some(TriangleRayHit {
+            t,
+            barycentric: bary,
+        })
     }
-    let sx = dir[kx] / dz;
-    let sy = dir[ky] / dz;
-    let sz = 1.0 / dz;
-    let a = tri[0] - origin;
-    let b = tri[1] - origin;
-    let c = tri[2] - origin;
-    let (ax, ay) = (a[kx] - sx * a[kz], a[ky] - sy * a[kz]);
-    let (bx, by) = (b[kx] - sx * b[kz], b[ky] - sy * b[kz]);
-    let (cx, cy) = (c[kx] - sx * c[kz], c[ky] - sy * c[kz]);
-    let u = cx * by - cy * bx;
-    let v = ax * cy - ay * cx;
-    let w = bx * ay - by * ax;
-    if (u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0) {
-        return None;
-    }
-    let det = u + v + w;
-    if det == 0.0 || !det.is_finite() {
-        return None;
-    }
-    let t_scaled = u * (sz * a[kz]) + v * (sz * b[kz]) + w * (sz * c[kz]);
-    // Range check before dividing, with det's sign folded in.
-    let (ts, ds) = if det < 0.0 {
-        (-t_scaled, -det)
-    } else {
-        (t_scaled, det)
-    };
-    if ts < 0.0 || ts > max_t * ds {
-        return None;
-    }
-    let inv = 1.0 / det;
-    let t = t_scaled * inv;
-    let bary = [u * inv, v * inv, w * inv];
-    if !(t.is_finite() && bary.iter().all(|x| x.is_finite())) || t > max_t {
-        return None;
-    }
-    Some(TriangleRayHit {
-        t,
-        barycentric: bary,
-    })
 }
 
 /// Closest point of the segment `[a, b]` to `p` and its parameter (0 for a zero-length
