@@ -2,6 +2,9 @@
 //! second on the landscape mesh and a generated ~1M-triangle mesh, beside parry3d's `TriMesh`
 //! on the same meshes and rays in the same run (single thread and all threads).
 //!
+//! Single-thread figures are thread CPU time (robust on a shared machine); the all-threads
+//! figures are wall time, so they depend on how many cores are free.
+//!
 //! Options: `--rays N` (rays per mesh, default 200000), `--grid N` (cells per side of the
 //! generated mesh, default 708 → 1,002,528 triangles), `--runs N` (timing repeats, median).
 
@@ -42,8 +45,34 @@ fn parse_args(args: &[String]) -> Args {
     a
 }
 
-/// Median wall time in seconds of `runs` calls of `f`.
+/// CPU time of the calling thread in seconds: on a loaded machine it counts only the time
+/// this thread actually ran, unlike wall time.
+fn thread_cpu_seconds() -> f64 {
+    let mut ts = libc::timespec {
+        tv_sec: 0,
+        tv_nsec: 0,
+    };
+    // SAFETY: `ts` is a valid, writable timespec; the clock id is a constant of libc.
+    unsafe { libc::clock_gettime(libc::CLOCK_THREAD_CPUTIME_ID, &mut ts) };
+    ts.tv_sec as f64 + ts.tv_nsec as f64 * 1e-9
+}
+
+/// Median single-thread CPU time in seconds of `runs` calls of `f`.
 fn median_time<T>(runs: usize, mut f: impl FnMut() -> T) -> (f64, T) {
+    let mut times = Vec::new();
+    let mut last = None;
+    for _ in 0..runs {
+        let t0 = thread_cpu_seconds();
+        let out = f();
+        times.push(thread_cpu_seconds() - t0);
+        last = Some(out);
+    }
+    times.sort_by(|a, b| a.total_cmp(b));
+    (times[times.len() / 2], last.expect("runs >= 1"))
+}
+
+/// Median wall time in seconds of `runs` calls of `f` (for the multi-threaded runs).
+fn median_wall_time<T>(runs: usize, mut f: impl FnMut() -> T) -> (f64, T) {
     let mut times = Vec::new();
     let mut last = None;
     for _ in 0..runs {
@@ -169,12 +198,12 @@ fn bench_mesh(name: &str, v: Vec<Vec3>, t: Vec<[u32; 3]>, args: &Args) {
             })
             .count()
     });
-    let (t_ours_mt, _) = median_time(args.runs, || {
+    let (t_ours_mt, _) = median_wall_time(args.runs, || {
         rays.par_iter()
             .filter(|(o, d)| mesh.raycast(*o, *d, max_t).is_some())
             .count()
     });
-    let (t_parry_mt, _) = median_time(args.runs, || {
+    let (t_parry_mt, _) = median_wall_time(args.runs, || {
         prays
             .par_iter()
             .filter(|r| {

@@ -84,13 +84,29 @@ struct Task {
     centroids: Aabb,
 }
 
+/// A primitive during the build: box, centroid and index, moved together so the passes over
+/// a range read memory in order.
+#[derive(Clone, Copy)]
+struct Prim {
+    aabb: Aabb,
+    centroid: Vec3,
+    id: u32,
+}
+
 /// Builds the hierarchy over `boxes` (at least one, all valid).
 pub(crate) fn build(boxes: &[Aabb]) -> BuildOutput {
     let n = boxes.len();
-    let centroids: Vec<Vec3> = boxes.iter().map(|b| b.center()).collect();
-    let mut order: Vec<u32> = (0..n as u32).collect();
+    let mut order: Vec<Prim> = boxes
+        .iter()
+        .enumerate()
+        .map(|(i, b)| Prim {
+            aabb: *b,
+            centroid: b.center(),
+            id: i as u32,
+        })
+        .collect();
     let mut nodes: Vec<BuildNode> = Vec::with_capacity(2 * n / MAX_LEAF_SIZE.max(2) + 8);
-    let root = bounds_of(boxes, &centroids, &order);
+    let root = bounds_of(&order);
     let mut stack = vec![Task {
         start: 0,
         end: n,
@@ -104,7 +120,7 @@ pub(crate) fn build(boxes: &[Aabb]) -> BuildOutput {
             nodes[p].first_or_right = index as u32;
         }
         let prims = &mut order[task.start..task.end];
-        match choose_split(boxes, &centroids, prims, &task.aabb, &task.centroids) {
+        match choose_split(prims, &task.aabb, &task.centroids) {
             Some((mid, left, right)) => {
                 nodes.push(BuildNode {
                     aabb: task.aabb,
@@ -137,15 +153,15 @@ pub(crate) fn build(boxes: &[Aabb]) -> BuildOutput {
     BuildOutput {
         nodes,
         escapes,
-        order,
+        order: order.iter().map(|p| p.id).collect(),
     }
 }
 
 /// Bounds and centroid bounds of a set of primitives.
-fn bounds_of(boxes: &[Aabb], centroids: &[Vec3], prims: &[u32]) -> Bin {
-    prims.iter().fold(EMPTY_BIN, |acc, &i| Bin {
-        aabb: acc.aabb.merge(&boxes[i as usize]),
-        centroids: acc.centroids.include_point(centroids[i as usize]),
+fn bounds_of(prims: &[Prim]) -> Bin {
+    prims.iter().fold(EMPTY_BIN, |acc, p| Bin {
+        aabb: acc.aabb.merge(&p.aabb),
+        centroids: acc.centroids.include_point(p.centroid),
         count: acc.count + 1,
     })
 }
@@ -165,13 +181,7 @@ fn escape_indices(nodes: &[BuildNode]) -> Vec<u32> {
 /// Chooses a split of `prims` (reordering it) and returns the size of the left part and the
 /// bounds of both parts, or `None` to make a leaf. One pass bins the primitives on all three
 /// axes at once; the children's bounds come from the bins.
-fn choose_split(
-    boxes: &[Aabb],
-    centroids: &[Vec3],
-    prims: &mut [u32],
-    bounds: &Aabb,
-    cb: &Aabb,
-) -> Option<(usize, Bin, Bin)> {
+fn choose_split(prims: &mut [Prim], bounds: &Aabb, cb: &Aabb) -> Option<(usize, Bin, Bin)> {
     let n = prims.len();
     if n <= 1 {
         return None;
@@ -192,10 +202,10 @@ fn choose_split(
     let mut best: Option<(Real, usize, Bin, Bin)> = None;
     if extent[axis] > 0.0 {
         let mut bins = [EMPTY_BIN; NUM_BINS];
-        for &i in prims.iter() {
-            let c = centroids[i as usize];
+        for p in prims.iter() {
+            let c = p.centroid;
             let bin = &mut bins[bin_of(c[axis], min, k)];
-            bin.aabb = bin.aabb.merge(&boxes[i as usize]);
+            bin.aabb = bin.aabb.merge(&p.aabb);
             bin.centroids = bin.centroids.include_point(c);
             bin.count += 1;
         }
@@ -227,17 +237,15 @@ fn choose_split(
             if n <= MAX_LEAF_SIZE && split_cost >= leaf_cost {
                 return None;
             }
-            let mid = partition(prims, |i| {
-                bin_of(centroids[i as usize][axis], min, k) <= last
-            });
+            let mid = partition(prims, |p| bin_of(p.centroid[axis], min, k) <= last);
             debug_assert!(mid == left.count as usize);
             Some((mid, left, right))
         }
         // All centroids coincide: split by position in the list.
         None if n > MAX_LEAF_SIZE => {
             let mid = n / 2;
-            let left = bounds_of(boxes, centroids, &prims[..mid]);
-            let right = bounds_of(boxes, centroids, &prims[mid..]);
+            let left = bounds_of(&prims[..mid]);
+            let right = bounds_of(&prims[mid..]);
             Some((mid, left, right))
         }
         None => None,
@@ -252,11 +260,11 @@ fn bin_of(c: Real, min: Real, k: Real) -> usize {
 
 /// In-place partition: elements satisfying `left` first. Returns their count. The order is
 /// a deterministic function of the input.
-fn partition(v: &mut [u32], left: impl Fn(u32) -> bool) -> usize {
+fn partition(v: &mut [Prim], left: impl Fn(&Prim) -> bool) -> usize {
     let mut i = 0;
     let mut j = v.len();
     while i < j {
-        if left(v[i]) {
+        if left(&v[i]) {
             i += 1;
         } else {
             j -= 1;

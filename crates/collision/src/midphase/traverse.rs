@@ -291,7 +291,7 @@ impl Bvh {
             if ns.ray_entry(0, &r, max_t) == Real::INFINITY {
                 return;
             }
-            let mut stack: Vec<(u32, Real)> = Vec::with_capacity(64);
+            let mut stack = RayStack::new();
             let mut node = 0usize;
             loop {
                 let data = ns.data(node);
@@ -382,5 +382,44 @@ pub(crate) fn right_child_of<N: NodeSet>(ns: &N, i: usize) -> usize {
         i + 2
     } else {
         left as usize
+    }
+}
+
+/// Deferred far children of the ordered ray walk: a fixed array, spilling to the heap only
+/// for trees deeper than it (degenerate inputs), so no allocation per ray.
+struct RayStack {
+    fixed: [(u32, Real); 48],
+    len: usize,
+    spill: Vec<(u32, Real)>,
+}
+
+impl RayStack {
+    #[inline]
+    fn new() -> Self {
+        RayStack {
+            fixed: [(0, 0.0); 48],
+            len: 0,
+            spill: Vec::new(),
+        }
+    }
+    #[inline]
+    fn push(&mut self, e: (u32, Real)) {
+        if self.len < self.fixed.len() {
+            self.fixed[self.len] = e;
+            self.len += 1;
+        } else {
+            self.spill.push(e);
+        }
+    }
+    #[inline]
+    fn pop(&mut self) -> Option<(u32, Real)> {
+        if let Some(e) = self.spill.pop() {
+            return Some(e);
+        }
+        if self.len == 0 {
+            return None;
+        }
+        self.len -= 1;
+        Some(self.fixed[self.len])
     }
 }
