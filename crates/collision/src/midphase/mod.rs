@@ -9,6 +9,7 @@
 
 mod build;
 mod bvh;
+mod heightfield_query;
 mod mesh_query;
 mod pair;
 mod traverse;
