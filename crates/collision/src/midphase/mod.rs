@@ -9,6 +9,7 @@
 
 mod build;
 mod bvh;
+mod compound_query;
 mod heightfield_query;
 mod mesh_query;
 mod pair;
@@ -17,5 +18,6 @@ mod triangle_query;
 
 pub use build::{MAX_LEAF_SIZE, NUM_BINS};
 pub use bvh::{Bvh, BvhLayout, Quantization, QuantizedNode, UnquantizedNode, MAX_PRIMITIVES};
+pub use compound_query::child_pair_overlaps;
 pub use mesh_query::{brute_force, triangle_aabbs, MeshPointProjection, MeshRayHit, MeshView};
 pub use triangle_query::{closest_point_on_triangle, ray_triangle, TriangleRayHit, WatertightRay};
