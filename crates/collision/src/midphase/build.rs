@@ -9,7 +9,7 @@
 //! needs. The build uses an explicit stack, so degenerate splits cannot overflow the call
 //! stack, and is fully deterministic (no sort with ties, no hashing).
 
-use crate::math::{Aabb, Real, Vec3};
+use crate::math::{Aabb, Real, Vec3, Vec3A};
 
 /// Number of centroid bins per axis.
 pub const NUM_BINS: usize = 16;
@@ -50,16 +50,52 @@ pub(crate) struct BuildOutput {
     pub order: Vec<u32>,
 }
 
+/// A box on SIMD vectors, for the build's inner loops.
+#[derive(Clone, Copy)]
+struct ABox {
+    min: Vec3A,
+    max: Vec3A,
+}
+
+impl ABox {
+    const EMPTY: ABox = ABox {
+        min: Vec3A::splat(Real::INFINITY),
+        max: Vec3A::splat(Real::NEG_INFINITY),
+    };
+    #[inline(always)]
+    fn merge(&self, o: &ABox) -> ABox {
+        ABox {
+            min: self.min.min(o.min),
+            max: self.max.max(o.max),
+        }
+    }
+    #[inline(always)]
+    fn include(&self, p: Vec3A) -> ABox {
+        ABox {
+            min: self.min.min(p),
+            max: self.max.max(p),
+        }
+    }
+    #[inline(always)]
+    fn area(&self) -> Real {
+        let e = (self.max - self.min).max(Vec3A::ZERO);
+        2.0 * (e.x * e.y + e.y * e.z + e.z * e.x)
+    }
+    fn aabb(&self) -> Aabb {
+        Aabb::new(Vec3::from(self.min), Vec3::from(self.max))
+    }
+}
+
 #[derive(Clone, Copy)]
 struct Bin {
-    aabb: Aabb,
-    centroids: Aabb,
+    aabb: ABox,
+    centroids: ABox,
     count: u32,
 }
 
 const EMPTY_BIN: Bin = Bin {
-    aabb: Aabb::EMPTY,
-    centroids: Aabb::EMPTY,
+    aabb: ABox::EMPTY,
+    centroids: ABox::EMPTY,
     count: 0,
 };
 
@@ -80,16 +116,17 @@ struct Task {
     end: usize,
     /// The node whose right child this range becomes.
     parent: Option<usize>,
-    aabb: Aabb,
-    centroids: Aabb,
+    aabb: ABox,
+    centroids: ABox,
 }
 
 /// A primitive during the build: box, centroid and index, moved together so the passes over
 /// a range read memory in order.
 #[derive(Clone, Copy)]
 struct Prim {
-    aabb: Aabb,
-    centroid: Vec3,
+    aabb: ABox,
+    /// Twice the centroid (`min + max`): binning only needs it up to scale.
+    centroid: Vec3A,
     id: u32,
 }
 
@@ -99,10 +136,13 @@ pub(crate) fn build(boxes: &[Aabb]) -> BuildOutput {
     let mut order: Vec<Prim> = boxes
         .iter()
         .enumerate()
-        .map(|(i, b)| Prim {
-            aabb: *b,
-            centroid: b.center(),
-            id: i as u32,
+        .map(|(i, b)| {
+            let (min, max) = (Vec3A::from(b.min), Vec3A::from(b.max));
+            Prim {
+                aabb: ABox { min, max },
+                centroid: min + max,
+                id: i as u32,
+            }
         })
         .collect();
     let mut nodes: Vec<BuildNode> = Vec::with_capacity(2 * n / MAX_LEAF_SIZE.max(2) + 8);
@@ -123,7 +163,7 @@ pub(crate) fn build(boxes: &[Aabb]) -> BuildOutput {
         match choose_split(prims, &task.aabb, &task.centroids) {
             Some((mid, left, right)) => {
                 nodes.push(BuildNode {
-                    aabb: task.aabb,
+                    aabb: task.aabb.aabb(),
                     first_or_right: 0,
                     count: 0,
                 });
@@ -143,7 +183,7 @@ pub(crate) fn build(boxes: &[Aabb]) -> BuildOutput {
                 });
             }
             None => nodes.push(BuildNode {
-                aabb: task.aabb,
+                aabb: task.aabb.aabb(),
                 first_or_right: task.start as u32,
                 count: (task.end - task.start) as u32,
             }),
@@ -161,7 +201,7 @@ pub(crate) fn build(boxes: &[Aabb]) -> BuildOutput {
 fn bounds_of(prims: &[Prim]) -> Bin {
     prims.iter().fold(EMPTY_BIN, |acc, p| Bin {
         aabb: acc.aabb.merge(&p.aabb),
-        centroids: acc.centroids.include_point(p.centroid),
+        centroids: acc.centroids.include(p.centroid),
         count: acc.count + 1,
     })
 }
@@ -181,14 +221,14 @@ fn escape_indices(nodes: &[BuildNode]) -> Vec<u32> {
 /// Chooses a split of `prims` (reordering it) and returns the size of the left part and the
 /// bounds of both parts, or `None` to make a leaf. One pass bins the primitives on all three
 /// axes at once; the children's bounds come from the bins.
-fn choose_split(prims: &mut [Prim], bounds: &Aabb, cb: &Aabb) -> Option<(usize, Bin, Bin)> {
+fn choose_split(prims: &mut [Prim], bounds: &ABox, cb: &ABox) -> Option<(usize, Bin, Bin)> {
     let n = prims.len();
     if n <= 1 {
         return None;
     }
     // Bin along the longest axis of the centroid bounds only, as Wald (2007) does: a third
     // of the binning work of a three-axis sweep for a small loss of tree quality.
-    let extent = cb.extents();
+    let extent = cb.max - cb.min;
     let axis = if extent.x >= extent.y && extent.x >= extent.z {
         0
     } else if extent.y >= extent.z {
@@ -206,7 +246,7 @@ fn choose_split(prims: &mut [Prim], bounds: &Aabb, cb: &Aabb) -> Option<(usize, 
             let c = p.centroid;
             let bin = &mut bins[bin_of(c[axis], min, k)];
             bin.aabb = bin.aabb.merge(&p.aabb);
-            bin.centroids = bin.centroids.include_point(c);
+            bin.centroids = bin.centroids.include(c);
             bin.count += 1;
         }
         let mut right = [EMPTY_BIN; NUM_BINS];
@@ -222,14 +262,13 @@ fn choose_split(prims: &mut [Prim], bounds: &Aabb, cb: &Aabb) -> Option<(usize, 
             if left.count == 0 || r.count == 0 {
                 continue;
             }
-            let cost = left.aabb.surface_area() * left.count as Real
-                + r.aabb.surface_area() * r.count as Real;
+            let cost = left.aabb.area() * left.count as Real + r.aabb.area() * r.count as Real;
             if !matches!(best, Some((c, ..)) if cost >= c) {
                 best = Some((cost, b, left, *r));
             }
         }
     }
-    let parent_area = bounds.surface_area();
+    let parent_area = bounds.area();
     match best {
         Some((cost, last, left, right)) => {
             let leaf_cost = n as Real * parent_area;
