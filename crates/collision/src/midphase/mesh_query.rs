@@ -6,7 +6,7 @@
 //! broken by the smaller triangle index, so results do not depend on the visit order).
 
 use super::bvh::Bvh;
-use super::triangle_query::{closest_point_on_triangle, WatertightRay};
+use super::triangle_query::{closest_point_on_triangle, TriangleRayHit, WatertightRay};
 use crate::math::{Aabb, Isometry, Real, Vec3};
 
 /// A ray hit on a mesh.
@@ -84,18 +84,35 @@ fn ray_hit(
     dir: Vec3,
     max_t: Real,
 ) -> Option<MeshRayHit> {
-    let h = ray.intersect(tri, max_t)?;
+    Some(complete_hit(
+        tri,
+        index,
+        origin,
+        dir,
+        ray.intersect(tri, max_t)?,
+    ))
+}
+
+/// A mesh hit from a triangle hit: point and unit face normal.
+#[inline]
+fn complete_hit(
+    tri: &[Vec3; 3],
+    index: u32,
+    origin: Vec3,
+    dir: Vec3,
+    h: TriangleRayHit,
+) -> MeshRayHit {
     let normal = (tri[1] - tri[0])
         .cross(tri[2] - tri[0])
         .try_normalize()
         .unwrap_or_else(|| -dir.normalize_or_zero());
-    Some(MeshRayHit {
+    MeshRayHit {
         triangle: index,
         t: h.t,
         barycentric: h.barycentric,
         point: origin + dir * h.t,
         normal,
-    })
+    }
 }
 
 /// True when `(t, i)` orders before `best` (ties broken by the smaller index).
@@ -145,18 +162,22 @@ impl<'a> MeshView<'a> {
     /// The closest hit of the ray `origin + t·dir`, `t ∈ [0, max_t]`.
     pub fn ray_closest(&self, origin: Vec3, dir: Vec3, max_t: Real) -> Option<MeshRayHit> {
         let ray = prepared(origin, dir, max_t)?;
-        let mut best: Option<MeshRayHit> = None;
+        // Keep (t, triangle) only; the hit is completed once, at the end.
+        let mut best: Option<(Real, u32)> = None;
+        let mut best_hit = None;
         self.bvh
             .for_each_candidate_on_ray_ordered(origin, dir, max_t, |i, limit| {
-                if let Some(h) = ray_hit(&ray, &self.triangle(i), i, origin, dir, *limit) {
-                    if better(h.t, i, best.map(|b| (b.t, b.triangle))) {
+                if let Some(h) = ray.intersect(&self.triangle(i), *limit) {
+                    if better(h.t, i, best) {
                         *limit = h.t;
-                        best = Some(h);
+                        best = Some((h.t, i));
+                        best_hit = Some(h);
                     }
                 }
                 true
             });
-        best
+        let (_, i) = best?;
+        Some(complete_hit(&self.triangle(i), i, origin, dir, best_hit?))
     }
 
     /// Some hit of the ray (the first found), for occlusion tests.
