@@ -221,6 +221,11 @@ fn batch_rays_equal_single_rays_and_layouts_agree() {
         assert_eq!(batch[i], u.raycast(origins[i], dirs[i], 100.0));
     }
     assert!(q.raycast_batch(&origins, &dirs[1..], 1.0).is_err());
+    let cps = q.closest_point_batch(&origins, 8.0);
+    assert!(cps.iter().any(|c| c.is_none()) && cps.iter().any(|c| c.is_some()));
+    for (p, c) in origins.iter().zip(&cps) {
+        assert_eq!(*c, brute_force::closest_point(&q.view(), *p, 8.0));
+    }
     let all = q.raycast_all(Vec3::new(5.1, 10.0, 5.2), -Vec3::Y, 100.0);
     assert_eq!(all.len(), 1);
     assert!(q
@@ -255,4 +260,15 @@ fn deforming_mesh_refits() {
         assert_eq!(mesh.raycast(p, d, 50.0), fresh.raycast(p, d, 50.0));
     }
     assert!(mesh.set_vertices(vec![Vec3::ZERO]).is_err());
+}
+
+#[test]
+fn meshes_round_trip_through_serde() {
+    let (v, t) = grid_mesh(6, 3.0, Vec3::ZERO);
+    let mesh = TriMesh::new(v, t).unwrap();
+    let bytes = postcard::to_allocvec(&mesh).unwrap();
+    let back: TriMesh = postcard::from_bytes(&bytes).unwrap();
+    assert_eq!(back, mesh);
+    let o = Vec3::new(1.1, 5.0, 1.3);
+    assert_eq!(back.raycast(o, -Vec3::Y, 10.0), mesh.raycast(o, -Vec3::Y, 10.0));
 }

@@ -234,6 +234,29 @@ impl TriMesh {
         self.view().closest_point(point, max_dist)
     }
 
+    /// Closest points of many query points within `max_dist`, in parallel with the
+    /// `parallel` feature.
+    pub fn closest_point_batch(
+        &self,
+        points: &[Vec3],
+        max_dist: Real,
+    ) -> Vec<Option<MeshPointProjection>> {
+        #[cfg(feature = "parallel")]
+        {
+            use rayon::prelude::*;
+            points
+                .par_iter()
+                .with_min_len(64)
+                .map(|&p| self.closest_point(p, max_dist))
+                .collect()
+        }
+        #[cfg(not(feature = "parallel"))]
+        points
+            .iter()
+            .map(|&p| self.closest_point(p, max_dist))
+            .collect()
+    }
+
     /// Triangles whose bounding boxes overlap `aabb` (mesh frame), ascending.
     pub fn overlapping_triangles(&self, aabb: &Aabb) -> Vec<u32> {
         let mut out = Vec::new();
