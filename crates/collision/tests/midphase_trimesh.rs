@@ -270,5 +270,8 @@ fn meshes_round_trip_through_serde() {
     let back: TriMesh = postcard::from_bytes(&bytes).unwrap();
     assert_eq!(back, mesh);
     let o = Vec3::new(1.1, 5.0, 1.3);
-    assert_eq!(back.raycast(o, -Vec3::Y, 10.0), mesh.raycast(o, -Vec3::Y, 10.0));
+    assert_eq!(
+        back.raycast(o, -Vec3::Y, 10.0),
+        mesh.raycast(o, -Vec3::Y, 10.0)
+    );
 }

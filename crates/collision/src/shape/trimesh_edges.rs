@@ -132,6 +132,10 @@ pub fn compute_edges(
             }
         }
     }
+    // Keys are unique (they include the triangle and edge), so the order is deterministic.
+    #[cfg(feature = "parallel")]
+    rayon::slice::ParallelSliceMut::par_sort_unstable(&mut list[..]);
+    #[cfg(not(feature = "parallel"))]
     list.sort_unstable();
     let normal = |t: u32| -> Option<Vec3> {
         let tri = indices[t as usize];
