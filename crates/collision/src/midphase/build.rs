@@ -15,10 +15,12 @@ use crate::math::{Aabb, Real, Vec3, Vec3A};
 pub const NUM_BINS: usize = 16;
 
 /// Largest number of primitives in a leaf.
-pub const MAX_LEAF_SIZE: usize = 4;
+pub const MAX_LEAF_SIZE: usize = 8;
 
-/// Cost of visiting an internal node relative to testing one primitive (SAH constant).
-const TRAVERSAL_COST: Real = 1.0;
+/// Cost of visiting an internal node relative to testing one primitive (SAH constant). Tuned
+/// with `carom-bench midphase`: leaves of up to 8 triangles beat small leaves on both build
+/// time and ray throughput (a leaf test reads contiguous data, a node visit often misses).
+const TRAVERSAL_COST: Real = 3.0;
 
 /// A node of the build output, before the final layout is chosen.
 #[derive(Debug, Clone, Copy)]
