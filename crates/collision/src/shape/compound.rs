@@ -1,8 +1,10 @@
-//! Compound shape: child shapes at local poses.
+//! Compound shape: child shapes at local poses, with a static BVH over the children's boxes
+//! (`midphase::Bvh`) for child-overlap queries (`midphase::compound_query`).
 
 use super::{MassProperties, Shape};
 use crate::error::{CaromError, Result};
 use crate::math::{check_isometry, Aabb, Isometry, Real};
+use crate::midphase::{Bvh, BvhLayout};
 use serde::{Deserialize, Serialize};
 use std::sync::Arc;
 
@@ -10,6 +12,8 @@ use std::sync::Arc;
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Compound {
     children: Vec<(Isometry, Arc<Shape>)>,
+    child_aabbs: Vec<Aabb>,
+    bvh: Bvh,
     local_aabb: Aabb,
 }
 
@@ -33,18 +37,29 @@ impl Compound {
             }
             checked.push((pose, shape));
         }
-        let local_aabb = checked
-            .iter()
-            .fold(Aabb::EMPTY, |acc, (pose, s)| acc.merge(&s.aabb(pose)));
+        let child_aabbs: Vec<Aabb> = checked.iter().map(|(pose, s)| s.aabb(pose)).collect();
+        let bvh = Bvh::new(&child_aabbs, BvhLayout::Unquantized)?;
         Ok(Compound {
             children: checked,
-            local_aabb,
+            local_aabb: bvh.root_aabb(),
+            child_aabbs,
+            bvh,
         })
     }
 
     /// The children and their poses.
     pub fn children(&self) -> &[(Isometry, Arc<Shape>)] {
         &self.children
+    }
+
+    /// Bounding box of each child in the compound's frame.
+    pub fn child_aabbs(&self) -> &[Aabb] {
+        &self.child_aabbs
+    }
+
+    /// The BVH over the children's boxes (primitive `i` is child `i`).
+    pub fn bvh(&self) -> &Bvh {
+        &self.bvh
     }
 
     /// Local bounding box.

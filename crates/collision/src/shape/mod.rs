@@ -11,7 +11,9 @@ mod cone;
 mod convex_hull;
 mod cuboid;
 mod cylinder;
+mod heightfield;
 mod mass;
+mod mesh_load;
 mod plane;
 mod quickhull;
 mod quickhull_builder;
@@ -21,6 +23,7 @@ mod sphere;
 mod support;
 mod triangle;
 mod trimesh;
+mod trimesh_edges;
 
 pub use capsule::Capsule;
 pub use compound::Compound;
@@ -28,6 +31,7 @@ pub use cone::Cone;
 pub use convex_hull::{ConvexHull, HullFace};
 pub use cuboid::{Cuboid, DEFAULT_MARGIN};
 pub use cylinder::Cylinder;
+pub use heightfield::HeightField;
 pub use mass::{polyhedron_mass_properties, MassProperties};
 pub use plane::Plane;
 pub use quickhull::{quickhull, HullPolygons};
@@ -35,7 +39,10 @@ pub use scaled::Scaled;
 pub use sphere::Sphere;
 pub use support::SupportMap;
 pub use triangle::Triangle;
-pub use trimesh::TriMesh;
+pub use trimesh::{TriMesh, TriMeshOptions};
+pub use trimesh_edges::{
+    compute_edges, weld_vertices, EdgeKind, MeshEdge, DEFAULT_FLAT_ANGLE, NO_NEIGHBOR,
+};
 
 use crate::error::{CaromError, Result};
 use crate::math::{check_positive, Aabb, Isometry, Real, Vec3};
@@ -67,6 +74,8 @@ pub enum Shape {
     Compound(Compound),
     /// A non-uniformly scaled convex shape.
     Scaled(Scaled),
+    /// A heightfield (static bodies).
+    HeightField(HeightField),
 }
 
 /// The kind of a [`Shape`], without its data.
@@ -94,6 +103,8 @@ pub enum ShapeKind {
     Compound,
     /// [`Scaled`]
     Scaled,
+    /// [`HeightField`]
+    HeightField,
 }
 
 /// A borrowed convex shape: the subset of [`Shape`] with a support map.
@@ -182,6 +193,7 @@ macro_rules! shape_dispatch {
             Shape::TriMesh($s) => $e,
             Shape::Compound($s) => $e,
             Shape::Scaled($s) => $e,
+            Shape::HeightField($s) => $e,
         }
     };
 }
@@ -201,6 +213,7 @@ impl Shape {
             Shape::TriMesh(_) => ShapeKind::TriMesh,
             Shape::Compound(_) => ShapeKind::Compound,
             Shape::Scaled(_) => ShapeKind::Scaled,
+            Shape::HeightField(_) => ShapeKind::HeightField,
         }
     }
 
@@ -218,6 +231,7 @@ impl Shape {
             ShapeKind::TriMesh => "triangle mesh",
             ShapeKind::Compound => "compound",
             ShapeKind::Scaled => "scaled shape",
+            ShapeKind::HeightField => "heightfield",
         }
     }
 
@@ -233,7 +247,9 @@ impl Shape {
             Shape::ConvexHull(s) => ConvexRef::ConvexHull(s),
             Shape::Triangle(s) => ConvexRef::Triangle(s),
             Shape::Scaled(s) => ConvexRef::Scaled(s),
-            Shape::Plane(_) | Shape::TriMesh(_) | Shape::Compound(_) => return None,
+            Shape::Plane(_) | Shape::TriMesh(_) | Shape::Compound(_) | Shape::HeightField(_) => {
+                return None
+            }
         })
     }
 
@@ -255,6 +271,7 @@ impl Shape {
                 Aabb::from_center_half_extents(pose.translation, Vec3::splat(s.radius()))
             }
             Shape::Cuboid(s) => s.local_aabb().transformed(pose),
+            Shape::HeightField(s) => s.local_aabb().transformed(pose),
             Shape::Plane(p) => {
                 let n = pose.transform_vector(p.normal());
                 let offset = p.offset() + n.dot(pose.translation);
@@ -293,7 +310,7 @@ impl Shape {
     /// Volume (0 for triangles, planes and open meshes).
     pub fn volume(&self) -> Real {
         match self {
-            Shape::Triangle(_) | Shape::Plane(_) => 0.0,
+            Shape::Triangle(_) | Shape::Plane(_) | Shape::HeightField(_) => 0.0,
             Shape::Sphere(s) => s.volume(),
             Shape::Cuboid(s) => s.volume(),
             Shape::Capsule(s) => s.volume(),
@@ -309,7 +326,7 @@ impl Shape {
     /// Mass properties for a uniform density (zero mass for triangles and planes).
     pub fn mass_properties(&self, density: Real) -> MassProperties {
         match self {
-            Shape::Triangle(_) | Shape::Plane(_) => MassProperties::ZERO,
+            Shape::Triangle(_) | Shape::Plane(_) | Shape::HeightField(_) => MassProperties::ZERO,
             Shape::Sphere(s) => s.mass_properties(density),
             Shape::Cuboid(s) => s.mass_properties(density),
             Shape::Capsule(s) => s.mass_properties(density),
@@ -358,4 +375,4 @@ macro_rules! impl_from {
 }
 impl_from!(Sphere => Sphere, Cuboid => Cuboid, Capsule => Capsule, Cylinder => Cylinder,
     Cone => Cone, ConvexHull => ConvexHull, Triangle => Triangle, Plane => Plane,
-    TriMesh => TriMesh, Compound => Compound, Scaled => Scaled);
+    TriMesh => TriMesh, Compound => Compound, Scaled => Scaled, HeightField => HeightField);
