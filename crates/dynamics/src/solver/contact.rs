@@ -184,8 +184,8 @@ fn solve_friction(c: &mut ContactConstraint, a: &mut SolverBody, b: &mut SolverB
 }
 
 /// Sequential impulses, velocity pass: friction then the normal rows (Box2D v2.4's order).
-/// The normal target is restitution for touching points and `-separation/dt` for
-/// speculative ones (they may close the gap but not more).
+/// The normal target is the restitution bounce, minus `separation/dt` for speculative points
+/// (they may close the gap but not more).
 pub(crate) fn solve_velocity_si(
     c: &mut ContactConstraint,
     a: &mut SolverBody,
@@ -195,13 +195,15 @@ pub(crate) fn solve_velocity_si(
 ) {
     solve_friction(c, a, b);
     for p in c.points[..c.len].iter_mut() {
-        let target = if p.separation > 0.0 {
-            -p.separation / dt
-        } else if p.relative_velocity < -threshold {
+        // Bullet's `setupContactConstraint`: the bounce `-e·v₀` if the point closes this step,
+        // minus the gap that may still be closed (speculative points).
+        let closes = p.separation + p.relative_velocity * dt <= 0.0;
+        let bounce = if p.relative_velocity < -threshold && closes {
             -c.restitution * p.relative_velocity
         } else {
             0.0
         };
+        let target = bounce - p.separation.max(0.0) / dt;
         let vn = (b.point_velocity(p.rb) - a.point_velocity(p.ra)).dot(c.normal);
         let new = (p.normal_impulse - p.normal_mass * (vn - target)).max(0.0);
         let imp = c.normal * (new - p.normal_impulse);

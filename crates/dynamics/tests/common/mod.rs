@@ -98,6 +98,7 @@ pub fn sphere_sphere(
     world: &DynamicsWorld,
     a: BodyHandle,
     b: BodyHandle,
+    margin: Real,
 ) -> Option<ContactManifold> {
     let radius = |h| match &*world.bodies().info(h).unwrap().shape.clone().unwrap() {
         Shape::Sphere(s) => s.radius(),
@@ -110,7 +111,7 @@ pub fn sphere_sphere(
     let (ra, rb) = (radius(a), radius(b));
     let d = cb - ca;
     let dist = d.length();
-    if dist - ra - rb > MARGIN || dist < 1e-9 {
+    if dist - ra - rb > margin || dist < 1e-9 {
         return None;
     }
     let n = d / dist;
@@ -295,6 +296,8 @@ pub struct Sim {
     pub sphere_pairs: Vec<(BodyHandle, BodyHandle)>,
     pub box_sphere_pairs: Vec<(BodyHandle, BodyHandle)>,
     pub prev: Vec<ContactManifold>,
+    /// Speculative margin of sphere–sphere contacts.
+    pub sphere_margin: Real,
     pub last_report: StepReport,
 }
 
@@ -316,6 +319,7 @@ impl Sim {
             sphere_pairs: Vec::new(),
             box_sphere_pairs: Vec::new(),
             prev: Vec::new(),
+            sphere_margin: MARGIN,
             last_report: StepReport::default(),
         }
     }
@@ -342,7 +346,7 @@ impl Sim {
         out.extend(
             self.sphere_pairs
                 .iter()
-                .filter_map(|&(a, b)| sphere_sphere(w, a, b)),
+                .filter_map(|&(a, b)| sphere_sphere(w, a, b, self.sphere_margin)),
         );
         out.extend(
             self.box_sphere_pairs
