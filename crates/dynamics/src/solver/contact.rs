@@ -195,15 +195,15 @@ pub(crate) fn solve_velocity_si(
 ) {
     solve_friction(c, a, b);
     for p in c.points[..c.len].iter_mut() {
-        // Bullet's `setupContactConstraint`: the bounce `-e·v₀` if the point closes this step,
-        // minus the gap that may still be closed (speculative points).
+        // The bounce `-e·v₀` if the point closes during this step (a speculative point then
+        // bounces up to one step early, keeping the energy), else the gap that may still be
+        // closed (Bullet subtracts the gap from the bounce, which loses energy).
         let closes = p.separation + p.relative_velocity * dt <= 0.0;
-        let bounce = if p.relative_velocity < -threshold && closes {
+        let target = if p.relative_velocity < -threshold && closes && c.restitution > 0.0 {
             -c.restitution * p.relative_velocity
         } else {
-            0.0
+            -p.separation.max(0.0) / dt
         };
-        let target = bounce - p.separation.max(0.0) / dt;
         let vn = (b.point_velocity(p.rb) - a.point_velocity(p.ra)).dot(c.normal);
         let new = (p.normal_impulse - p.normal_mass * (vn - target)).max(0.0);
         let imp = c.normal * (new - p.normal_impulse);
