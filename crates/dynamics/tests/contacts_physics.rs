@@ -23,7 +23,8 @@ fn dropped_sphere_rests_at_its_radius() {
         let y = sim.pos(b).y;
         let slop = sim.world.params().solver.linear_slop;
         assert!(
-            (y - r).abs() <= slop,
+            // Split impulses leave up to the slop of penetration (plus round-off).
+            (y - r).abs() <= slop + 1e-4,
             "{kind:?}: y = {y}, expected {r} ± {slop}"
         );
         assert!(sim.world.bodies().linear_velocity(b).unwrap().length() < 0.01);

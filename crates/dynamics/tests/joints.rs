@@ -314,7 +314,12 @@ fn ragdoll_from_the_scene_comes_to_rest() {
             sim.world.create_joint(&desc).unwrap();
             assert!(!sim.world.should_collide(desc.body_a, desc.body_b));
         }
-        for _ in 0..steps(600, 600) {
+        let mut p = *sim.world.params();
+        p.sleep.enabled = false;
+        sim.world.set_params(p).unwrap();
+        // Sleeping off: the ragdoll itself must settle. The sequential-impulse solver keeps a
+        // small joint/contact jitter (a few cm/s, see the report), hence the bounds.
+        for _ in 0..1800 {
             sim.step();
         }
         for &h in &handles[1..] {
