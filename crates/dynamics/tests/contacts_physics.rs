@@ -187,3 +187,44 @@ fn without_gravity_momentum_is_conserved_and_energy_does_not_grow() {
         }
     }
 }
+
+#[test]
+fn kinematic_platform_moves_by_its_velocity_and_carries_a_box() {
+    for kind in KINDS {
+        let mut sim = Sim::new(kind, Vec3::new(0.0, -9.81, 0.0));
+        let platform = sim
+            .world
+            .create_body(&BodyDesc {
+                body_type: BodyType::Kinematic,
+                shape: Some(cuboid(Vec3::new(2.0, 0.25, 2.0))),
+                pose: Isometry::from_translation(Vec3::new(0.0, 1.0, 0.0)),
+                linear_velocity: Vec3::new(1.0, 0.0, 0.0),
+                ..Default::default()
+            })
+            .unwrap();
+        let rider = sim
+            .world
+            .create_body(&box_desc(Vec3::new(0.0, 1.75, 0.0)))
+            .unwrap();
+        sim.box_pairs.push((platform, rider));
+        for _ in 0..120 {
+            sim.step();
+        }
+        let px = sim.pos(platform).x;
+        assert!((px - 2.0).abs() < 1e-3, "{kind:?}: platform at {px}");
+        let v = sim.world.bodies().linear_velocity(rider).unwrap();
+        assert!(
+            (v - Vec3::new(1.0, 0.0, 0.0)).length() < 0.02,
+            "{kind:?}: rider velocity {v}"
+        );
+        // The rider slips until friction has brought it to speed: v² / (2 μ g) behind.
+        let slip = -1.0 / (2.0 * 0.5 * 9.81);
+        let rel = sim.pos(rider) - sim.pos(platform);
+        // Within one step of relative travel (v·dt = 1.7 cm).
+        assert!(
+            (rel.x - slip).abs() < sim.dt,
+            "{kind:?}: rider at {rel}, slip {slip}"
+        );
+        assert!((rel.y - 0.75).abs() < 0.03, "{kind:?}: rider at {rel}");
+    }
+}
