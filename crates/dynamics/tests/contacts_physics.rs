@@ -228,3 +228,45 @@ fn kinematic_platform_moves_by_its_velocity_and_carries_a_box() {
         assert!((rel.y - 0.75).abs() < 0.03, "{kind:?}: rider at {rel}");
     }
 }
+
+#[test]
+fn free_asymmetric_body_keeps_angular_momentum_without_gaining_energy() {
+    // A box spinning near its intermediate axis tumbles (Dzhanibekov); the implicit
+    // gyroscopic term keeps |L| and does not gain energy.
+    let mut w = DynamicsWorld::new(WorldParams {
+        gravity: Vec3::ZERO,
+        ..Default::default()
+    })
+    .unwrap();
+    let mut d = BodyDesc::dynamic(cuboid(Vec3::new(0.1, 0.4, 0.8)), Isometry::IDENTITY, 1000.0);
+    d.angular_velocity = Vec3::new(0.05, 4.0, 0.05);
+    d.can_sleep = false;
+    let b = w.create_body(&d).unwrap();
+    let l = |w: &DynamicsWorld| {
+        let s = w.bodies();
+        s.inv_inertia_world(b).unwrap().inverse() * s.angular_velocity(b).unwrap()
+    };
+    let (l0, e0) = (l(&w), w.bodies().kinetic_energy());
+    let mut min_alignment: Real = 1.0;
+    for _ in 0..600 {
+        w.step(1.0 / 60.0, &mut []).unwrap();
+        let e = w.bodies().kinetic_energy();
+        assert!(e <= e0 * (1.0 + 1e-4), "energy grew {e0} -> {e}");
+        let axis = w.bodies().pose(b).unwrap().transform_vector(Vec3::Y);
+        min_alignment = min_alignment.min(axis.dot(Vec3::Y));
+    }
+    let l1 = l(&w);
+    assert!(
+        (l1.length() - l0.length()).abs() < 0.05 * l0.length(),
+        "|L| {l0} -> {l1}"
+    );
+    assert!(
+        l1.normalize().dot(l0.normalize()) > 0.99,
+        "L turned: {l0} -> {l1}"
+    );
+    // The intermediate axis flips over (its world direction reverses).
+    assert!(
+        min_alignment < -0.5,
+        "the body should tumble: {min_alignment}"
+    );
+}

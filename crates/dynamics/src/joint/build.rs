@@ -277,3 +277,33 @@ fn cone_twist(f: &Frames, swing1: Real, swing2: Real, twist: Real, rows: &mut Ve
         ));
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rotation_vector_is_axis_times_angle() {
+        let axis = Vec3::new(1.0, -2.0, 0.5).normalize();
+        for angle in [0.0, 1e-4, 0.5, 2.0, 3.1] {
+            let q = Quat::from_axis_angle(axis, angle);
+            assert!(
+                (rotation_vector(q) - axis * angle).length() < 1e-4,
+                "{angle}"
+            );
+            // The double cover gives the same rotation vector.
+            assert!(
+                (rotation_vector(-q) - axis * angle).length() < 1e-4,
+                "{angle}"
+            );
+        }
+    }
+
+    #[test]
+    fn wrap_angle_stays_in_range() {
+        use carom_collision::math::consts::PI;
+        assert!((wrap_angle(1.5 * PI) + 0.5 * PI).abs() < 1e-5);
+        assert!((wrap_angle(-1.5 * PI) - 0.5 * PI).abs() < 1e-5);
+        assert_eq!(wrap_angle(0.25), 0.25);
+    }
+}

@@ -237,3 +237,41 @@ pub(crate) fn inv_or_zero(k: Real) -> Real {
         0.0
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn softness_scales_sum_to_one_and_stiffen_with_hertz() {
+        let h = 1.0 / 240.0;
+        let mut last_rate = 0.0;
+        for hertz in [1.0, 10.0, 30.0, 60.0] {
+            let s = Softness::new(hertz, 1.0, h);
+            // a2·a3 + a3 = (a2 + 1) / (1 + a2) = 1.
+            assert!((s.mass_scale + s.impulse_scale - 1.0).abs() < 1e-5);
+            assert!(s.bias_rate > last_rate);
+            last_rate = s.bias_rate;
+        }
+        assert_eq!(Softness::new(0.0, 1.0, h), Softness::RIGID);
+    }
+
+    #[test]
+    fn params_are_validated() {
+        let p = SolverParams {
+            substeps: 0,
+            ..Default::default()
+        };
+        assert!(p.validate().is_err());
+        let p = SolverParams {
+            contact_hertz: Real::NAN,
+            ..Default::default()
+        };
+        assert!(p
+            .validate()
+            .unwrap_err()
+            .to_string()
+            .contains("contact_hertz"));
+        assert!(SolverParams::default().validate().is_ok());
+    }
+}
