@@ -24,7 +24,6 @@ fn main() {
         (SolverKind::SoftStep, 10),
         (SolverKind::SequentialImpulse, 10),
         (SolverKind::SequentialImpulse, 40),
-        (SolverKind::SequentialImpulse, 1),
     ];
     println!("scene      solver             iters  settle_m  drift_m   solver_ms/step");
     for pyr in [false, true] {

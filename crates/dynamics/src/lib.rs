@@ -23,10 +23,24 @@
 //!
 //! ## Solver choice
 //!
-//! The soft step ([`SolverKind::SoftStep`]) is the default: on the stacking tests it drifts
-//! less than sequential impulses at a similar cost (figures in the crate's tests and the
-//! project report); sequential impulses remain selectable with
-//! [`DynamicsWorld::set_solver`].
+//! The soft step ([`SolverKind::SoftStep`], 4 substeps, 1 iteration + 1 relax each) is the
+//! default. Measured with `cargo run --release -p carom-dynamics --example solver_compare`
+//! (unit boxes of 1000 kg, dt = 1/60 s, 2000 steps, analytic face contacts; drift after the
+//! first second):
+//!
+//! | scene      | solver                  | settling | drift  |
+//! |------------|-------------------------|----------|--------|
+//! | 10-stack   | soft step               | 2.6 cm   | 0.5 cm |
+//! | 10-stack   | sequential impulses, 10 | collapses (13 m)  |
+//! | 10-stack   | sequential impulses, 40 | 0.6 cm   | 1.4 cm |
+//! | pyramid 20 | soft step               | 3.8 cm   | 0.7 cm |
+//! | pyramid 20 | sequential impulses, 10 | 5.5 cm   | 4.3 cm |
+//! | pyramid 20 | sequential impulses, 40 | 1.0 cm   | 0.1 cm |
+//!
+//! At equal cost (10 iterations vs 4 substeps) the soft step is the stable one; sequential
+//! impulses need about four times the work to hold the same stacks. The soft step's settling
+//! is the compression of its 30 Hz contact springs under the stack's weight. Sequential
+//! impulses remain selectable with [`DynamicsWorld::set_solver`].
 #![warn(missing_docs)]
 
 pub use carom_collision as collision;

@@ -95,7 +95,7 @@ impl Default for SolverParams {
             linear_slop: 0.005,
             restitution_threshold: 1.0,
             warm_starting: true,
-            parallel_min_batch: 64,
+            parallel_min_batch: 256,
         }
     }
 }
