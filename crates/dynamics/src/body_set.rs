@@ -75,6 +75,8 @@ pub struct BodySet {
     pub(crate) force: Vec<Vec3>,
     pub(crate) torque: Vec<Vec3>,
     pub(crate) info: Vec<BodyInfo>,
+    /// Slots woken by user calls since the last step (reported by the next step).
+    pub(crate) woken_by_user: Vec<usize>,
 }
 
 impl BodySet {
@@ -341,6 +343,9 @@ impl BodySet {
 
     pub(crate) fn wake_slot(&mut self, i: usize) {
         if self.info[i].body_type == BodyType::Dynamic {
+            if self.info[i].sleeping {
+                self.woken_by_user.push(i);
+            }
             self.info[i].sleeping = false;
             self.info[i].sleep_time = 0.0;
         }

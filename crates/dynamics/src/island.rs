@@ -93,7 +93,8 @@ pub(crate) fn build(set: &BodySet, manifolds: &[ContactManifold], joints: &Joint
 }
 
 /// Wakes every sleeping body whose island holds an awake body or touches a moving kinematic
-/// body. Returns the woken bodies in slot order.
+/// body. Returns the bodies woken since the last step (by this or by user calls), in slot
+/// order.
 pub(crate) fn wake_islands(
     set: &mut BodySet,
     roots: &[usize],
@@ -116,14 +117,21 @@ pub(crate) fn wake_islands(
             }
         }
     }
-    let mut woken = Vec::new();
+    let mut slots: Vec<usize> = std::mem::take(&mut set.woken_by_user);
     for i in 0..roots.len() {
         if is_dynamic(set, i) && set.info[i].sleeping && awake[roots[i]] {
             set.wake_slot(i);
-            woken.push(set.handle_of(i));
+            slots.push(i);
         }
     }
-    woken
+    set.woken_by_user.clear();
+    slots.sort_unstable();
+    slots.dedup();
+    slots
+        .into_iter()
+        .filter(|&i| set.is_alive(i))
+        .map(|i| set.handle_of(i))
+        .collect()
 }
 
 /// Advances the rest timers and puts resting islands to sleep. Returns the bodies that fell

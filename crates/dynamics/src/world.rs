@@ -46,7 +46,8 @@ impl Default for WorldParams {
 /// What changed during a step.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct StepReport {
-    /// Bodies woken this step (the broadphase moves them to its active tree).
+    /// Bodies woken since the last step, by contacts, joints or user calls (the broadphase
+    /// moves them to its active tree).
     pub woken: Vec<BodyHandle>,
     /// Bodies that fell asleep this step (to the broadphase's resting tree).
     pub slept: Vec<BodyHandle>,
