@@ -1,0 +1,379 @@
+//! Live bodies: generational handles and hot data in flat arrays.
+//!
+//! The layout follows Box2D v3 (`body.h`, `solver_set.h`) and the architecture note: the data
+//! the solver touches every step (centre-of-mass positions, rotations, velocities, inverse
+//! masses, world inverse inertias) lives in one flat array per quantity, indexed by the body
+//! slot; cold data (damping, user data, …) lives in [`BodyInfo`]. Handles are
+//! `(index, generation)` pairs (Box2D's `b2BodyId`): removing a body bumps the slot's
+//! generation, so a stale handle is an error, never another body.
+
+use crate::body::{BodyDesc, BodyType};
+use carom_collision::math::{check_finite_vec, Isometry, Mat3, Quat, Real, Vec3};
+use carom_collision::shape::Shape;
+use carom_collision::{CaromError, Result};
+use std::sync::Arc;
+
+/// A stable reference to a body: slot index plus the generation of that slot.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct BodyHandle {
+    /// Slot index in the body arrays.
+    pub index: u32,
+    /// Generation of the slot when the body was created.
+    pub generation: u32,
+}
+
+/// Cold per-body data.
+#[derive(Debug, Clone)]
+pub struct BodyInfo {
+    /// Dynamic, kinematic or static.
+    pub body_type: BodyType,
+    /// Collision shape, if any.
+    pub shape: Option<Arc<Shape>>,
+    /// Mass (0 for non-dynamic bodies).
+    pub mass: Real,
+    /// Centre of mass in the body frame.
+    pub local_com: Vec3,
+    /// Inverse inertia about the centre of mass in body axes.
+    pub inv_inertia_local: Mat3,
+    /// Friction coefficient.
+    pub friction: Real,
+    /// Restitution coefficient.
+    pub restitution: Real,
+    /// Linear damping per second.
+    pub linear_damping: Real,
+    /// Angular damping per second.
+    pub angular_damping: Real,
+    /// Gravity multiplier.
+    pub gravity_scale: Real,
+    /// Whether the body may sleep.
+    pub can_sleep: bool,
+    /// Largest linear speed.
+    pub max_linear_speed: Real,
+    /// Largest angular speed.
+    pub max_angular_speed: Real,
+    /// User value.
+    pub user_data: u64,
+    /// True while the body sleeps.
+    pub sleeping: bool,
+    /// Time the body has spent below the sleep velocity thresholds, s.
+    pub sleep_time: Real,
+}
+
+/// All bodies of a world. Hot data is public read-only through accessors; the arrays are
+/// indexed by [`BodyHandle::index`] and contain dead slots (zero inverse mass).
+#[derive(Debug, Clone, Default)]
+pub struct BodySet {
+    generation: Vec<u32>,
+    alive: Vec<bool>,
+    free: Vec<u32>,
+    pub(crate) position: Vec<Vec3>,
+    pub(crate) rotation: Vec<Quat>,
+    pub(crate) linear_velocity: Vec<Vec3>,
+    pub(crate) angular_velocity: Vec<Vec3>,
+    pub(crate) inv_mass: Vec<Real>,
+    pub(crate) inv_inertia_world: Vec<Mat3>,
+    pub(crate) force: Vec<Vec3>,
+    pub(crate) torque: Vec<Vec3>,
+    pub(crate) info: Vec<BodyInfo>,
+    /// Slots woken by user calls since the last step (reported by the next step).
+    pub(crate) woken_by_user: Vec<usize>,
+}
+
+impl BodySet {
+    /// An empty set.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Validates `desc` and adds the body.
+    pub fn insert(&mut self, desc: &BodyDesc) -> Result<BodyHandle> {
+        let (pose, m) = desc.validate()?;
+        let info = BodyInfo {
+            body_type: desc.body_type,
+            shape: desc.shape.clone(),
+            mass: m.mass,
+            local_com: m.local_com,
+            inv_inertia_local: m.inv_inertia_local,
+            friction: desc.friction,
+            restitution: desc.restitution,
+            linear_damping: desc.linear_damping,
+            angular_damping: desc.angular_damping,
+            gravity_scale: desc.gravity_scale,
+            can_sleep: desc.can_sleep,
+            max_linear_speed: desc.max_linear_speed,
+            max_angular_speed: desc.max_angular_speed,
+            user_data: desc.user_data,
+            sleeping: false,
+            sleep_time: 0.0,
+        };
+        let com = pose.transform_point(m.local_com);
+        let index = match self.free.pop() {
+            Some(i) => i as usize,
+            None => {
+                self.generation.push(0);
+                self.alive.push(false);
+                self.position.push(Vec3::ZERO);
+                self.rotation.push(Quat::IDENTITY);
+                self.linear_velocity.push(Vec3::ZERO);
+                self.angular_velocity.push(Vec3::ZERO);
+                self.inv_mass.push(0.0);
+                self.inv_inertia_world.push(Mat3::ZERO);
+                self.force.push(Vec3::ZERO);
+                self.torque.push(Vec3::ZERO);
+                self.info.push(info.clone());
+                self.generation.len() - 1
+            }
+        };
+        self.alive[index] = true;
+        self.position[index] = com;
+        self.rotation[index] = pose.rotation;
+        self.linear_velocity[index] = desc.linear_velocity;
+        self.angular_velocity[index] = desc.angular_velocity;
+        self.inv_mass[index] = m.inv_mass;
+        self.force[index] = Vec3::ZERO;
+        self.torque[index] = Vec3::ZERO;
+        self.info[index] = info;
+        self.update_world_inertia(index);
+        Ok(BodyHandle {
+            index: index as u32,
+            generation: self.generation[index],
+        })
+    }
+
+    /// Removes a body; its handle (and every copy of it) becomes stale.
+    pub fn remove(&mut self, h: BodyHandle) -> Result<()> {
+        let i = self.slot(h)?;
+        self.alive[i] = false;
+        self.generation[i] = self.generation[i].wrapping_add(1);
+        self.inv_mass[i] = 0.0;
+        self.inv_inertia_world[i] = Mat3::ZERO;
+        self.linear_velocity[i] = Vec3::ZERO;
+        self.angular_velocity[i] = Vec3::ZERO;
+        self.info[i].body_type = BodyType::Static;
+        self.info[i].shape = None;
+        self.free.push(i as u32);
+        Ok(())
+    }
+
+    /// The slot of a live handle, or [`CaromError::UnknownHandle`].
+    pub fn slot(&self, h: BodyHandle) -> Result<usize> {
+        let i = h.index as usize;
+        if i < self.alive.len() && self.alive[i] && self.generation[i] == h.generation {
+            Ok(i)
+        } else {
+            Err(CaromError::UnknownHandle(format!("{h:?}")))
+        }
+    }
+
+    /// True if `h` names a live body.
+    pub fn contains(&self, h: BodyHandle) -> bool {
+        self.slot(h).is_ok()
+    }
+
+    /// Number of slots (live or dead): the length of every hot array.
+    pub fn capacity(&self) -> usize {
+        self.alive.len()
+    }
+
+    /// Number of live bodies.
+    pub fn len(&self) -> usize {
+        self.alive.len() - self.free.len()
+    }
+
+    /// True if there is no live body.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Handles of the live bodies, in slot order.
+    pub fn handles(&self) -> impl Iterator<Item = BodyHandle> + '_ {
+        (0..self.alive.len())
+            .filter(|&i| self.alive[i])
+            .map(|i| self.handle_of(i))
+    }
+
+    pub(crate) fn handle_of(&self, i: usize) -> BodyHandle {
+        BodyHandle {
+            index: i as u32,
+            generation: self.generation[i],
+        }
+    }
+
+    pub(crate) fn is_alive(&self, i: usize) -> bool {
+        self.alive[i]
+    }
+
+    /// True for a live, dynamic, awake body slot.
+    pub(crate) fn is_awake_dynamic(&self, i: usize) -> bool {
+        self.alive[i] && self.info[i].body_type == BodyType::Dynamic && !self.info[i].sleeping
+    }
+
+    /// Recomputes the world inverse inertia `R I⁻¹ Rᵀ` of slot `i` from its rotation.
+    pub(crate) fn update_world_inertia(&mut self, i: usize) {
+        let r = Mat3::from_quat(self.rotation[i]);
+        self.inv_inertia_world[i] = r * self.info[i].inv_inertia_local * r.transpose();
+    }
+
+    /// Cold data of a body.
+    pub fn info(&self, h: BodyHandle) -> Result<&BodyInfo> {
+        Ok(&self.info[self.slot(h)?])
+    }
+
+    /// Pose of the body frame (the shape's frame).
+    pub fn pose(&self, h: BodyHandle) -> Result<Isometry> {
+        Ok(self.pose_of(self.slot(h)?))
+    }
+
+    pub(crate) fn pose_of(&self, i: usize) -> Isometry {
+        let q = self.rotation[i];
+        Isometry::new(self.position[i] - q * self.info[i].local_com, q)
+    }
+
+    /// World position of the centre of mass.
+    pub fn center_of_mass(&self, h: BodyHandle) -> Result<Vec3> {
+        Ok(self.position[self.slot(h)?])
+    }
+
+    /// Linear velocity of the centre of mass.
+    pub fn linear_velocity(&self, h: BodyHandle) -> Result<Vec3> {
+        Ok(self.linear_velocity[self.slot(h)?])
+    }
+
+    /// Angular velocity (world axes).
+    pub fn angular_velocity(&self, h: BodyHandle) -> Result<Vec3> {
+        Ok(self.angular_velocity[self.slot(h)?])
+    }
+
+    /// Inverse mass (0 for static and kinematic bodies).
+    pub fn inv_mass(&self, h: BodyHandle) -> Result<Real> {
+        Ok(self.inv_mass[self.slot(h)?])
+    }
+
+    /// World inverse inertia tensor.
+    pub fn inv_inertia_world(&self, h: BodyHandle) -> Result<Mat3> {
+        Ok(self.inv_inertia_world[self.slot(h)?])
+    }
+
+    /// True while the body sleeps.
+    pub fn is_sleeping(&self, h: BodyHandle) -> Result<bool> {
+        Ok(self.info[self.slot(h)?].sleeping)
+    }
+
+    /// Sets the pose of the body frame (teleport); wakes the body.
+    pub fn set_pose(&mut self, h: BodyHandle, pose: Isometry) -> Result<()> {
+        let i = self.slot(h)?;
+        let pose = carom_collision::math::check_isometry("pose", pose)?;
+        self.position[i] = pose.transform_point(self.info[i].local_com);
+        self.rotation[i] = pose.rotation;
+        self.update_world_inertia(i);
+        self.wake_slot(i);
+        Ok(())
+    }
+
+    /// Sets the linear velocity; wakes the body. Static bodies reject it.
+    pub fn set_linear_velocity(&mut self, h: BodyHandle, v: Vec3) -> Result<()> {
+        let i = self.movable_slot(h, "linear_velocity")?;
+        self.linear_velocity[i] = check_finite_vec("linear_velocity", v)?;
+        self.wake_slot(i);
+        Ok(())
+    }
+
+    /// Sets the angular velocity; wakes the body. Static bodies reject it.
+    pub fn set_angular_velocity(&mut self, h: BodyHandle, w: Vec3) -> Result<()> {
+        let i = self.movable_slot(h, "angular_velocity")?;
+        self.angular_velocity[i] = check_finite_vec("angular_velocity", w)?;
+        self.wake_slot(i);
+        Ok(())
+    }
+
+    /// Adds a force (N) at the centre of mass for the next step; wakes the body.
+    pub fn add_force(&mut self, h: BodyHandle, f: Vec3) -> Result<()> {
+        let i = self.slot(h)?;
+        self.force[i] += check_finite_vec("force", f)?;
+        self.wake_slot(i);
+        Ok(())
+    }
+
+    /// Adds a torque (N·m) for the next step; wakes the body.
+    pub fn add_torque(&mut self, h: BodyHandle, t: Vec3) -> Result<()> {
+        let i = self.slot(h)?;
+        self.torque[i] += check_finite_vec("torque", t)?;
+        self.wake_slot(i);
+        Ok(())
+    }
+
+    /// Adds a force at a world point (force plus the torque `(p − com) × f`).
+    pub fn add_force_at_point(&mut self, h: BodyHandle, f: Vec3, point: Vec3) -> Result<()> {
+        let i = self.slot(h)?;
+        check_finite_vec("force", f)?;
+        check_finite_vec("point", point)?;
+        self.force[i] += f;
+        self.torque[i] += (point - self.position[i]).cross(f);
+        self.wake_slot(i);
+        Ok(())
+    }
+
+    /// Applies an impulse (N·s) at a world point: changes the velocities now; wakes the body.
+    pub fn apply_impulse(&mut self, h: BodyHandle, impulse: Vec3, point: Vec3) -> Result<()> {
+        let i = self.slot(h)?;
+        check_finite_vec("impulse", impulse)?;
+        check_finite_vec("point", point)?;
+        self.linear_velocity[i] += impulse * self.inv_mass[i];
+        self.angular_velocity[i] +=
+            self.inv_inertia_world[i] * (point - self.position[i]).cross(impulse);
+        self.wake_slot(i);
+        Ok(())
+    }
+
+    /// Applies an angular impulse (N·m·s); wakes the body.
+    pub fn apply_angular_impulse(&mut self, h: BodyHandle, impulse: Vec3) -> Result<()> {
+        let i = self.slot(h)?;
+        check_finite_vec("angular_impulse", impulse)?;
+        self.angular_velocity[i] += self.inv_inertia_world[i] * impulse;
+        self.wake_slot(i);
+        Ok(())
+    }
+
+    /// Wakes a body (its island wakes at the next step).
+    pub fn wake(&mut self, h: BodyHandle) -> Result<()> {
+        let i = self.slot(h)?;
+        self.wake_slot(i);
+        Ok(())
+    }
+
+    pub(crate) fn wake_slot(&mut self, i: usize) {
+        if self.info[i].body_type == BodyType::Dynamic {
+            if self.info[i].sleeping {
+                self.woken_by_user.push(i);
+            }
+            self.info[i].sleeping = false;
+            self.info[i].sleep_time = 0.0;
+        }
+    }
+
+    fn movable_slot(&self, h: BodyHandle, what: &str) -> Result<usize> {
+        let i = self.slot(h)?;
+        if self.info[i].body_type == BodyType::Static {
+            return Err(CaromError::invalid(
+                what,
+                format!("{h:?}"),
+                "a static body cannot be given a velocity",
+            ));
+        }
+        Ok(i)
+    }
+
+    /// Kinetic energy `½ m v² + ½ ωᵀ I ω` of all dynamic bodies.
+    pub fn kinetic_energy(&self) -> Real {
+        let mut e = 0.0;
+        for i in 0..self.capacity() {
+            if self.alive[i] && self.inv_mass[i] > 0.0 {
+                let v = self.linear_velocity[i];
+                let w = self.angular_velocity[i];
+                let inertia = self.inv_inertia_world[i].inverse();
+                e += 0.5 * v.length_squared() / self.inv_mass[i] + 0.5 * w.dot(inertia * w);
+            }
+        }
+        e
+    }
+}

@@ -1,0 +1,324 @@
+//! Contact constraints: preparation from [`ContactManifold`] inputs and the per-constraint
+//! solve routines of both solvers.
+//!
+//! Each manifold becomes one constraint with up to four points; each point has a normal row
+//! (impulse ≥ 0) and a two-dimensional friction row clamped to the Coulomb cone
+//! `|λ_t| ≤ μ λ_n` (Catto, "Iterative Dynamics with Temporal Coherence"; Bullet's
+//! `btSequentialImpulseConstraintSolver::setupContactConstraint`). The anchor of a point is
+//! the midpoint of its two witness points, as in Box2D.
+
+use super::coloring::PairConstraint;
+use super::{inv_or_zero, Softness, SolverBody, SolverParams};
+use crate::body_set::BodySet;
+use crate::contact::{ContactManifold, MAX_MANIFOLD_POINTS};
+use carom_collision::math::{orthonormal_basis, Real, Vec3};
+
+/// One prepared contact point.
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct PointConstraint {
+    pub ra: Vec3,
+    pub rb: Vec3,
+    pub normal_mass: Real,
+    pub tangent_mass: [Real; 2],
+    pub separation: Real,
+    /// Normal relative velocity at preparation (for restitution).
+    pub relative_velocity: Real,
+    pub normal_impulse: Real,
+    pub tangent_impulse: [Real; 2],
+    pub push_impulse: Real,
+    pub max_normal_impulse: Real,
+}
+
+/// One prepared manifold.
+#[derive(Debug, Clone)]
+pub(crate) struct ContactConstraint {
+    pub a: usize,
+    pub b: usize,
+    pub manifold: usize,
+    pub normal: Vec3,
+    pub tangent: [Vec3; 2],
+    pub friction: Real,
+    pub restitution: Real,
+    pub softness: Softness,
+    pub points: [PointConstraint; MAX_MANIFOLD_POINTS],
+    pub len: usize,
+}
+
+impl PairConstraint for ContactConstraint {
+    fn bodies(&self) -> (usize, usize) {
+        (self.a, self.b)
+    }
+}
+
+/// `1 / (J M⁻¹ Jᵀ)` for an impulse along `dir` at lever arms `ra`, `rb`.
+#[inline]
+pub(crate) fn effective_mass(
+    a: &SolverBody,
+    b: &SolverBody,
+    ra: Vec3,
+    rb: Vec3,
+    dir: Vec3,
+) -> Real {
+    let rna = ra.cross(dir);
+    let rnb = rb.cross(dir);
+    let k = a.inv_m + b.inv_m + rna.dot(a.inv_i * rna) + rnb.dot(b.inv_i * rnb);
+    inv_or_zero(k)
+}
+
+/// Builds the constraints of the manifolds that touch an awake dynamic body. `impulse_in`
+/// scales the stored impulses (per-step units) to the solver's units (0 disables warm start).
+pub(crate) fn prepare(
+    manifolds: &[ContactManifold],
+    set: &BodySet,
+    bodies: &[SolverBody],
+    impulse_in: Real,
+    soft: Softness,
+    static_soft: Softness,
+) -> Vec<ContactConstraint> {
+    let mut out = Vec::with_capacity(manifolds.len());
+    for (m_index, m) in manifolds.iter().enumerate() {
+        let (a, b) = (m.body_a.index as usize, m.body_b.index as usize);
+        if m.points().is_empty() || !(bodies[a].dynamic || bodies[b].dynamic) {
+            continue;
+        }
+        let (ba, bb) = (&bodies[a], &bodies[b]);
+        let (pose_a, pose_b) = (set.pose_of(a), set.pose_of(b));
+        let (com_a, com_b) = (set.position[a], set.position[b]);
+        let n = m.normal.normalize();
+        let mut points = [PointConstraint::default(); MAX_MANIFOLD_POINTS];
+        let mut centre_velocity = Vec3::ZERO;
+        for (k, p) in m.points().iter().enumerate() {
+            let c = 0.5 * (pose_a.transform_point(p.local_a) + pose_b.transform_point(p.local_b));
+            let (ra, rb) = (c - com_a, c - com_b);
+            let dv = bb.point_velocity(rb) - ba.point_velocity(ra);
+            centre_velocity += dv;
+            points[k] = PointConstraint {
+                ra,
+                rb,
+                normal_mass: effective_mass(ba, bb, ra, rb, n),
+                separation: p.separation,
+                relative_velocity: dv.dot(n),
+                normal_impulse: p.normal_impulse * impulse_in,
+                tangent_impulse: [
+                    p.tangent_impulse[0] * impulse_in,
+                    p.tangent_impulse[1] * impulse_in,
+                ],
+                ..Default::default()
+            };
+        }
+        let t1 = friction_direction(m.tangent, n, centre_velocity / m.points().len() as Real);
+        let t2 = n.cross(t1);
+        for pt in points.iter_mut().take(m.points().len()) {
+            pt.tangent_mass = [
+                effective_mass(ba, bb, pt.ra, pt.rb, t1),
+                effective_mass(ba, bb, pt.ra, pt.rb, t2),
+            ];
+        }
+        out.push(ContactConstraint {
+            a,
+            b,
+            manifold: m_index,
+            normal: n,
+            tangent: [t1, t2],
+            friction: m.friction,
+            restitution: m.restitution,
+            softness: if ba.dynamic && bb.dynamic {
+                soft
+            } else {
+                static_soft
+            },
+            points,
+            len: m.points().len(),
+        });
+    }
+    out
+}
+
+/// The first friction direction: the cached one if still roughly in the tangent plane
+/// (direction caching keeps warm-started friction meaningful), else the sliding direction,
+/// else a fixed basis vector of the normal.
+fn friction_direction(cached: Vec3, n: Vec3, relative_velocity: Vec3) -> Vec3 {
+    let c = cached - n * n.dot(cached);
+    if c.length_squared() > 0.25 {
+        return c.normalize();
+    }
+    let vt = relative_velocity - n * n.dot(relative_velocity);
+    if vt.length_squared() > 1e-6 {
+        return vt.normalize();
+    }
+    orthonormal_basis(n).0
+}
+
+/// Applies the accumulated impulses (warm start).
+pub(crate) fn warm_start(c: &mut ContactConstraint, a: &mut SolverBody, b: &mut SolverBody) {
+    for p in &c.points[..c.len] {
+        let imp = c.normal * p.normal_impulse
+            + c.tangent[0] * p.tangent_impulse[0]
+            + c.tangent[1] * p.tangent_impulse[1];
+        a.apply(-imp, p.ra);
+        b.apply(imp, p.rb);
+    }
+}
+
+/// Coulomb friction on both tangent directions, clamped to the cone `μ λ_n`.
+#[inline]
+fn solve_friction(c: &mut ContactConstraint, a: &mut SolverBody, b: &mut SolverBody) {
+    for p in c.points[..c.len].iter_mut() {
+        let dv = b.point_velocity(p.rb) - a.point_velocity(p.ra);
+        let old = p.tangent_impulse;
+        let mut new = [
+            old[0] - p.tangent_mass[0] * dv.dot(c.tangent[0]),
+            old[1] - p.tangent_mass[1] * dv.dot(c.tangent[1]),
+        ];
+        let max = c.friction * p.normal_impulse;
+        let len_sq = new[0] * new[0] + new[1] * new[1];
+        if len_sq > max * max {
+            let s = max / len_sq.sqrt();
+            new = [new[0] * s, new[1] * s];
+        }
+        p.tangent_impulse = new;
+        let imp = c.tangent[0] * (new[0] - old[0]) + c.tangent[1] * (new[1] - old[1]);
+        a.apply(-imp, p.ra);
+        b.apply(imp, p.rb);
+    }
+}
+
+/// Sequential impulses, velocity pass: friction then the normal rows (Box2D v2.4's order).
+/// The normal target is the restitution bounce, minus `separation/dt` for speculative points
+/// (they may close the gap but not more).
+pub(crate) fn solve_velocity_si(
+    c: &mut ContactConstraint,
+    a: &mut SolverBody,
+    b: &mut SolverBody,
+    dt: Real,
+    threshold: Real,
+) {
+    solve_friction(c, a, b);
+    for p in c.points[..c.len].iter_mut() {
+        // The bounce `-e·v₀` if the point closes during this step (a speculative point then
+        // bounces up to one step early, keeping the energy), else the gap that may still be
+        // closed (Bullet subtracts the gap from the bounce, which loses energy).
+        let closes = p.separation + p.relative_velocity * dt <= 0.0;
+        let target = if p.relative_velocity < -threshold && closes && c.restitution > 0.0 {
+            -c.restitution * p.relative_velocity
+        } else {
+            -p.separation.max(0.0) / dt
+        };
+        let vn = (b.point_velocity(p.rb) - a.point_velocity(p.ra)).dot(c.normal);
+        let new = (p.normal_impulse - p.normal_mass * (vn - target)).max(0.0);
+        let imp = c.normal * (new - p.normal_impulse);
+        p.normal_impulse = new;
+        a.apply(-imp, p.ra);
+        b.apply(imp, p.rb);
+    }
+}
+
+/// Sequential impulses, split-impulse pass (Bullet's `resolveSplitPenetrationImpulse`): push
+/// pseudo-velocities (`dp`, `dq`) so that `erp` of the penetration beyond the slop is removed
+/// this step; they move the bodies once and are then discarded, so no energy is added.
+pub(crate) fn solve_push_si(
+    c: &mut ContactConstraint,
+    a: &mut SolverBody,
+    b: &mut SolverBody,
+    erp_over_dt: Real,
+    slop: Real,
+) {
+    for p in c.points[..c.len].iter_mut() {
+        let target = erp_over_dt * (-(p.separation + slop)).max(0.0);
+        if target <= 0.0 && p.push_impulse == 0.0 {
+            continue;
+        }
+        let vn = ((b.dp + b.dq.cross(p.rb)) - (a.dp + a.dq.cross(p.ra))).dot(c.normal);
+        let new = (p.push_impulse + p.normal_mass * (target - vn)).max(0.0);
+        let imp = c.normal * (new - p.push_impulse);
+        p.push_impulse = new;
+        a.apply_push(-imp, p.ra);
+        b.apply_push(imp, p.rb);
+    }
+}
+
+/// Soft step: friction, then the normal rows (Box2D v3's `b2SolveContact`, with Box2D v2.4's
+/// friction-first order, which creeps less in the pyramid test). The separation is
+/// updated from the position deltas of the substeps; with `use_bias` penetration is pushed
+/// out softly (capped at `max_push`), without it (relax) the rows are rigid and bias-free.
+pub(crate) fn solve_soft(
+    c: &mut ContactConstraint,
+    a: &mut SolverBody,
+    b: &mut SolverBody,
+    inv_h: Real,
+    max_push: Real,
+    use_bias: bool,
+) {
+    solve_friction(c, a, b);
+    for p in c.points[..c.len].iter_mut() {
+        let d = (b.dp - a.dp) + (b.dq.cross(p.rb) - a.dq.cross(p.ra));
+        let s = p.separation + d.dot(c.normal);
+        let (bias, mass_scale, impulse_scale) = if s > 0.0 {
+            (s * inv_h, 1.0, 0.0)
+        } else if use_bias {
+            let soft = c.softness;
+            (
+                (soft.bias_rate * s).max(-max_push),
+                soft.mass_scale,
+                soft.impulse_scale,
+            )
+        } else {
+            (0.0, 1.0, 0.0)
+        };
+        let vn = (b.point_velocity(p.rb) - a.point_velocity(p.ra)).dot(c.normal);
+        let lambda = -p.normal_mass * mass_scale * (vn + bias) - impulse_scale * p.normal_impulse;
+        let new = (p.normal_impulse + lambda).max(0.0);
+        let imp = c.normal * (new - p.normal_impulse);
+        p.normal_impulse = new;
+        p.max_normal_impulse = p.max_normal_impulse.max(new);
+        a.apply(-imp, p.ra);
+        b.apply(imp, p.rb);
+    }
+}
+
+/// Soft step, restitution pass (Box2D v3's `b2ApplyRestitution`): points that approached
+/// faster than the threshold and carried an impulse get the bounce velocity `-e·v₀`.
+pub(crate) fn apply_restitution(
+    c: &mut ContactConstraint,
+    a: &mut SolverBody,
+    b: &mut SolverBody,
+    threshold: Real,
+) {
+    if c.restitution == 0.0 {
+        return;
+    }
+    for p in c.points[..c.len].iter_mut() {
+        if p.relative_velocity > -threshold || p.max_normal_impulse == 0.0 {
+            continue;
+        }
+        let vn = (b.point_velocity(p.rb) - a.point_velocity(p.ra)).dot(c.normal);
+        let lambda = -p.normal_mass * (vn + c.restitution * p.relative_velocity);
+        let new = (p.normal_impulse + lambda).max(0.0);
+        let imp = c.normal * (new - p.normal_impulse);
+        p.normal_impulse = new;
+        a.apply(-imp, p.ra);
+        b.apply(imp, p.rb);
+    }
+}
+
+/// Writes the accumulated impulses (scaled to per-step units) and the friction direction back
+/// into the manifolds.
+pub(crate) fn store(cons: &[ContactConstraint], manifolds: &mut [ContactManifold], scale: Real) {
+    for c in cons {
+        let m = &mut manifolds[c.manifold];
+        m.tangent = c.tangent[0];
+        for (out, p) in m.points_mut().iter_mut().zip(&c.points[..c.len]) {
+            out.normal_impulse = p.normal_impulse * scale;
+            out.tangent_impulse = [p.tangent_impulse[0] * scale, p.tangent_impulse[1] * scale];
+        }
+    }
+}
+
+/// Default softness values for the two solvers.
+pub(crate) fn softness_pair(params: &SolverParams, h: Real) -> (Softness, Softness) {
+    let hertz = params.contact_hertz.min(0.25 / h);
+    (
+        Softness::new(hertz, params.contact_damping_ratio, h),
+        Softness::new(2.0 * hertz, params.contact_damping_ratio, h),
+    )
+}

@@ -1,0 +1,277 @@
+//! Constraint solvers: sequential impulses with split impulses, and the substepping soft step.
+//!
+//! Both solve the same prepared data: contact constraints (module `contact`) built from the
+//! [`crate::ContactManifold`] inputs, and generic one-dimensional joint rows (module `rows`). They
+//! differ in how position error is removed without adding energy:
+//! - Sequential impulses ([`SolverKind::SequentialImpulse`]), after Catto, "Iterative Dynamics with Temporal Coherence"
+//!   (GDC 2005) and Bullet's `btSequentialImpulseConstraintSolver` — warm-started velocity
+//!   iterations, then split impulses (Bullet's `splitImpulse`): penetration is resolved by
+//!   pseudo-velocities that move the bodies but are thrown away after the step.
+//! - The soft step ([`SolverKind::SoftStep`]), Box2D v3's solver (Catto, "Solver2D", 2024) — substeps with
+//!   soft constraints (a contact hertz and damping ratio), a relax pass without bias, and a
+//!   restitution pass at the end.
+//!
+//! Contacts are graph-coloured (module `coloring`): constraints of one colour share no dynamic
+//! body, so a colour may be solved in parallel with rayon and still give the same bits as a
+//! sequential solve (each constraint reads and writes only its own two bodies).
+
+pub(crate) mod coloring;
+pub(crate) mod contact;
+pub(crate) mod joints;
+pub(crate) mod rows;
+pub(crate) mod sequential;
+pub(crate) mod soft_step;
+mod timing;
+
+pub use timing::StepTimings;
+
+use crate::body_set::BodySet;
+use crate::contact::ContactManifold;
+use crate::joint::JointSet;
+
+use carom_collision::math::{check_non_negative, check_positive, Mat3, Real, Vec3};
+use carom_collision::{CaromError, Result};
+
+/// Which solver [`crate::DynamicsWorld::step`] uses.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum SolverKind {
+    /// Sequential impulses with split impulses (Bullet).
+    SequentialImpulse,
+    /// Substepping soft step (Box2D v3). The default: see the crate docs for the comparison.
+    #[default]
+    SoftStep,
+}
+
+/// Solver settings. Defaults follow Bullet (sequential impulses) and Box2D v3 (soft step).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SolverParams {
+    /// Which solver.
+    pub kind: SolverKind,
+    /// Sequential impulses: velocity iterations (Bullet's `m_numIterations`).
+    pub velocity_iterations: u32,
+    /// Sequential impulses: split-impulse (position) iterations.
+    pub position_iterations: u32,
+    /// Sequential impulses: fraction of the penetration removed per step by split impulses
+    /// (Bullet's `m_erp2`).
+    pub split_erp: Real,
+    /// Sequential impulses: Baumgarte factor of the joints (Bullet's `m_erp`).
+    pub joint_erp: Real,
+    /// Soft step: substeps per step (Box2D's `subStepCount`).
+    pub substeps: u32,
+    /// Soft step: contact stiffness in hertz (capped at a quarter of the substep rate).
+    pub contact_hertz: Real,
+    /// Soft step: contact damping ratio.
+    pub contact_damping_ratio: Real,
+    /// Soft step: joint stiffness in hertz.
+    pub joint_hertz: Real,
+    /// Soft step: joint damping ratio.
+    pub joint_damping_ratio: Real,
+    /// Soft step: largest speed at which penetration is pushed out, m/s.
+    pub max_push_velocity: Real,
+    /// Penetration allowed without correction, m (Box2D's `linearSlop`).
+    pub linear_slop: Real,
+    /// Approach speed below which restitution is ignored, m/s.
+    pub restitution_threshold: Real,
+    /// Apply last step's impulses first.
+    pub warm_starting: bool,
+    /// Smallest colour solved in parallel (when the `parallel` feature is on).
+    pub parallel_min_batch: usize,
+}
+
+impl Default for SolverParams {
+    fn default() -> Self {
+        SolverParams {
+            kind: SolverKind::default(),
+            velocity_iterations: 10,
+            position_iterations: 10,
+            split_erp: 0.8,
+            joint_erp: 0.2,
+            substeps: 4,
+            contact_hertz: 30.0,
+            contact_damping_ratio: 10.0,
+            joint_hertz: 60.0,
+            joint_damping_ratio: 2.0,
+            max_push_velocity: 3.0,
+            linear_slop: 0.005,
+            restitution_threshold: 1.0,
+            warm_starting: true,
+            parallel_min_batch: 256,
+        }
+    }
+}
+
+impl SolverParams {
+    /// Checks every value.
+    pub fn validate(&self) -> Result<()> {
+        for (name, n) in [
+            ("solver.velocity_iterations", self.velocity_iterations),
+            ("solver.substeps", self.substeps),
+        ] {
+            if n == 0 || n > 1000 {
+                return Err(CaromError::invalid(name, n, "must be in 1..=1000"));
+            }
+        }
+        if self.position_iterations > 1000 {
+            let n = self.position_iterations;
+            return Err(CaromError::invalid(
+                "solver.position_iterations",
+                n,
+                "must be <= 1000",
+            ));
+        }
+        check_non_negative("solver.split_erp", self.split_erp)?;
+        check_non_negative("solver.joint_erp", self.joint_erp)?;
+        check_positive("solver.contact_hertz", self.contact_hertz)?;
+        check_non_negative("solver.contact_damping_ratio", self.contact_damping_ratio)?;
+        check_positive("solver.joint_hertz", self.joint_hertz)?;
+        check_non_negative("solver.joint_damping_ratio", self.joint_damping_ratio)?;
+        check_positive("solver.max_push_velocity", self.max_push_velocity)?;
+        check_non_negative("solver.linear_slop", self.linear_slop)?;
+        check_non_negative("solver.restitution_threshold", self.restitution_threshold)?;
+        Ok(())
+    }
+}
+
+/// Everything one solver step works on.
+pub(crate) struct StepContext<'a> {
+    pub set: &'a mut BodySet,
+    pub bodies: &'a mut [SolverBody],
+    pub manifolds: &'a mut [ContactManifold],
+    pub joints: &'a mut JointSet,
+    pub gravity: Vec3,
+    pub dt: Real,
+    pub params: &'a SolverParams,
+    pub gyroscopic: bool,
+    pub parallel: bool,
+    pub timings: &'a mut StepTimings,
+}
+
+/// Per-body state the solver works on (Box2D v3's `b2BodyState`), copied from the body set
+/// at the start of a step and back at the end. `dp`/`dq` are the position and rotation-vector
+/// deltas since the start of the step (soft step), or the split-impulse pseudo-velocities
+/// (sequential impulses).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct SolverBody {
+    pub v: Vec3,
+    pub w: Vec3,
+    pub dp: Vec3,
+    pub dq: Vec3,
+    pub inv_m: Real,
+    pub inv_i: Mat3,
+    /// Dynamic and awake: the only bodies whose state the solver writes.
+    pub dynamic: bool,
+}
+
+impl SolverBody {
+    /// Applies an impulse `p` at lever arm `r` to the velocities.
+    #[inline]
+    pub fn apply(&mut self, p: Vec3, r: Vec3) {
+        self.v += p * self.inv_m;
+        self.w += self.inv_i * r.cross(p);
+    }
+
+    /// Applies an impulse to the pseudo-velocities (`dp`, `dq`).
+    #[inline]
+    pub fn apply_push(&mut self, p: Vec3, r: Vec3) {
+        self.dp += p * self.inv_m;
+        self.dq += self.inv_i * r.cross(p);
+    }
+
+    /// Velocity of the material point at lever arm `r`.
+    #[inline]
+    pub fn point_velocity(&self, r: Vec3) -> Vec3 {
+        self.v + self.w.cross(r)
+    }
+}
+
+/// Soft-constraint coefficients (Box2D v3's `b2Softness`, from Catto's "Solver2D"): a spring
+/// of frequency `hertz` and damping ratio `zeta` integrated implicitly over a step `h`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Softness {
+    pub bias_rate: Real,
+    pub mass_scale: Real,
+    pub impulse_scale: Real,
+}
+
+impl Softness {
+    /// A rigid constraint without position feedback.
+    pub const RIGID: Softness = Softness {
+        bias_rate: 0.0,
+        mass_scale: 1.0,
+        impulse_scale: 0.0,
+    };
+
+    /// `b2MakeSoft`: ω = 2π·hertz, a1 = 2ζ + hω, a2 = hω·a1, a3 = 1/(1 + a2);
+    /// bias rate ω/a1, mass scale a2·a3, impulse scale a3.
+    pub fn new(hertz: Real, zeta: Real, h: Real) -> Softness {
+        if hertz <= 0.0 {
+            return Softness::RIGID;
+        }
+        let omega = 2.0 * carom_collision::math::consts::PI * hertz;
+        let a1 = 2.0 * zeta + h * omega;
+        let a2 = h * omega * a1;
+        let a3 = 1.0 / (1.0 + a2);
+        Softness {
+            bias_rate: omega / a1,
+            mass_scale: a2 * a3,
+            impulse_scale: a3,
+        }
+    }
+
+    /// Baumgarte stabilisation: a rigid constraint that removes `erp` of the error per step.
+    pub fn baumgarte(erp: Real, dt: Real) -> Softness {
+        Softness {
+            bias_rate: erp / dt,
+            mass_scale: 1.0,
+            impulse_scale: 0.0,
+        }
+    }
+}
+
+/// Inverse of a scalar effective mass, 0 when the mass is zero.
+#[inline]
+pub(crate) fn inv_or_zero(k: Real) -> Real {
+    if k > Real::EPSILON {
+        1.0 / k
+    } else {
+        0.0
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn softness_scales_sum_to_one_and_stiffen_with_hertz() {
+        let h = 1.0 / 240.0;
+        let mut last_rate = 0.0;
+        for hertz in [1.0, 10.0, 30.0, 60.0] {
+            let s = Softness::new(hertz, 1.0, h);
+            // a2·a3 + a3 = (a2 + 1) / (1 + a2) = 1.
+            assert!((s.mass_scale + s.impulse_scale - 1.0).abs() < 1e-5);
+            assert!(s.bias_rate > last_rate);
+            last_rate = s.bias_rate;
+        }
+        assert_eq!(Softness::new(0.0, 1.0, h), Softness::RIGID);
+    }
+
+    #[test]
+    fn params_are_validated() {
+        let p = SolverParams {
+            substeps: 0,
+            ..Default::default()
+        };
+        assert!(p.validate().is_err());
+        let p = SolverParams {
+            contact_hertz: Real::NAN,
+            ..Default::default()
+        };
+        assert!(p
+            .validate()
+            .unwrap_err()
+            .to_string()
+            .contains("contact_hertz"));
+        assert!(SolverParams::default().validate().is_ok());
+    }
+}

@@ -1,0 +1,92 @@
+//! The substepping soft step of Box2D v3 (Catto, "Solver2D", 2024; `solver.c`,
+//! `contact_solver.c`).
+//!
+//! Per step: prepare the constraints once; then for each of `n` substeps of `h = dt/n`:
+//! integrate velocities, warm start, solve with soft position feedback (contact hertz and
+//! damping ratio; penetration recovery capped at `max_push_velocity`), integrate positions,
+//! and relax (solve again without bias, so the feedback leaves no velocity behind); finally a
+//! restitution pass. Constraint errors follow the substeps through the position deltas
+//! (`dp`, `dq`) accumulated since the start of the step. Impulses are per substep inside and
+//! stored per step outside.
+
+use super::coloring::{colour, solve_coloured};
+use super::timing::lap;
+use super::{contact, joints, Softness, StepContext};
+use crate::integrate;
+use carom_collision::math::{Real, Vec3};
+use std::time::Instant;
+
+/// Runs one step of the soft-step solver.
+pub(crate) fn step(ctx: &mut StepContext) {
+    let p = *ctx.params;
+    let n = p.substeps.max(1);
+    let h = ctx.dt / n as Real;
+    let inv_h = 1.0 / h;
+    let mut t = Instant::now();
+
+    for b in ctx.bodies.iter_mut() {
+        b.dp = Vec3::ZERO;
+        b.dq = Vec3::ZERO;
+    }
+    let warm = if p.warm_starting {
+        1.0 / n as Real
+    } else {
+        0.0
+    };
+    let (soft, static_soft) = contact::softness_pair(&p, h);
+    let cons = contact::prepare(ctx.manifolds, ctx.set, ctx.bodies, warm, soft, static_soft);
+    let mut rows = joints::build_all(ctx.joints, ctx.set, ctx.bodies, h, warm);
+    let dynamic: Vec<bool> = ctx.bodies.iter().map(|b| b.dynamic).collect();
+    let pairs: Vec<(usize, usize)> = cons.iter().map(|c| (c.a, c.b)).collect();
+    let col = colour(&pairs, &dynamic);
+    let mut cons: Vec<_> = col.order.iter().map(|&k| cons[k].clone()).collect();
+    let ranges = col.ranges;
+    let joint_soft = Softness::new(p.joint_hertz, p.joint_damping_ratio, h);
+    let (par, min) = (ctx.parallel, p.parallel_min_batch);
+    let max_push = p.max_push_velocity;
+    lap(&mut t, &mut ctx.timings.prepare);
+
+    for _ in 0..n {
+        integrate::integrate_velocities(ctx.set, ctx.bodies, ctx.gravity, h, ctx.gyroscopic);
+        lap(&mut t, &mut ctx.timings.forces);
+
+        if p.warm_starting {
+            joints::warm_start(&mut rows, ctx.bodies);
+            solve_coloured(
+                &mut cons,
+                &ranges,
+                ctx.bodies,
+                par,
+                min,
+                contact::warm_start,
+            );
+        }
+        lap(&mut t, &mut ctx.timings.warm_start);
+
+        joints::solve(&mut rows, ctx.bodies, joint_soft, inv_h, true, true);
+        solve_coloured(&mut cons, &ranges, ctx.bodies, par, min, |c, a, b| {
+            contact::solve_soft(c, a, b, inv_h, max_push, true)
+        });
+        integrate::clamp_speeds(ctx.set, ctx.bodies);
+        lap(&mut t, &mut ctx.timings.solve);
+
+        integrate::integrate_positions(ctx.set, ctx.bodies, h, false);
+        lap(&mut t, &mut ctx.timings.integrate);
+
+        joints::solve(&mut rows, ctx.bodies, joint_soft, inv_h, false, true);
+        solve_coloured(&mut cons, &ranges, ctx.bodies, par, min, |c, a, b| {
+            contact::solve_soft(c, a, b, inv_h, max_push, false)
+        });
+        lap(&mut t, &mut ctx.timings.relax);
+    }
+
+    let threshold = p.restitution_threshold;
+    solve_coloured(&mut cons, &ranges, ctx.bodies, par, min, |c, a, b| {
+        contact::apply_restitution(c, a, b, threshold)
+    });
+    lap(&mut t, &mut ctx.timings.restitution);
+
+    contact::store(&cons, ctx.manifolds, n as Real);
+    joints::store(&rows, ctx.joints, n as Real);
+    lap(&mut t, &mut ctx.timings.store);
+}

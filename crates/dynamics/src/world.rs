@@ -1,0 +1,254 @@
+//! [`DynamicsWorld`]: bodies, joints and the step pipeline, fed with contacts from outside.
+//!
+//! `step(dt, contacts)` runs: validate → islands (wake) → gravity and forces → prepare
+//! constraints → warm start → solve velocities → integrate → relax / split impulses →
+//! restitution → write back impulses → joint breaking → sleeping, with per-stage timings.
+
+use crate::body::{BodyDesc, BodyType};
+use crate::body_set::{BodyHandle, BodySet};
+use crate::contact::ContactManifold;
+use crate::integrate;
+use crate::island::{self, SleepParams};
+use crate::joint::{JointDesc, JointHandle, JointSet};
+use crate::solver::{self, SolverBody, SolverKind, SolverParams, StepContext, StepTimings};
+use carom_collision::math::{check_finite_vec, Real, Vec3};
+use carom_collision::{CaromError, Result};
+use std::time::Instant;
+
+/// World settings.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct WorldParams {
+    /// Gravity, m/s².
+    pub gravity: Vec3,
+    /// Solver choice and settings.
+    pub solver: SolverParams,
+    /// Sleeping settings.
+    pub sleep: SleepParams,
+    /// Implicit gyroscopic term (see [`crate::integrate`]).
+    pub gyroscopic: bool,
+    /// Solve large colours in parallel (with the `parallel` feature). Results are
+    /// bit-identical either way.
+    pub parallel: bool,
+}
+
+impl Default for WorldParams {
+    fn default() -> Self {
+        WorldParams {
+            gravity: Vec3::new(0.0, -9.81, 0.0),
+            solver: SolverParams::default(),
+            sleep: SleepParams::default(),
+            gyroscopic: true,
+            parallel: true,
+        }
+    }
+}
+
+/// What changed during a step.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct StepReport {
+    /// Bodies woken since the last step, by contacts, joints or user calls (the broadphase
+    /// moves them to its active tree).
+    pub woken: Vec<BodyHandle>,
+    /// Bodies that fell asleep this step (to the broadphase's resting tree).
+    pub slept: Vec<BodyHandle>,
+    /// Joints that broke this step.
+    pub broken_joints: Vec<JointHandle>,
+    /// Per-stage timings.
+    pub timings: StepTimings,
+}
+
+/// Rigid bodies and joints, stepped with externally generated contacts.
+#[derive(Debug, Clone)]
+pub struct DynamicsWorld {
+    bodies: BodySet,
+    joints: JointSet,
+    params: WorldParams,
+    solver_bodies: Vec<SolverBody>,
+}
+
+impl DynamicsWorld {
+    /// An empty world.
+    pub fn new(params: WorldParams) -> Result<Self> {
+        Self::check_params(&params)?;
+        Ok(DynamicsWorld {
+            bodies: BodySet::new(),
+            joints: JointSet::default(),
+            params,
+            solver_bodies: Vec::new(),
+        })
+    }
+
+    fn check_params(p: &WorldParams) -> Result<()> {
+        check_finite_vec("gravity", p.gravity)?;
+        p.solver.validate()?;
+        p.sleep.validate()
+    }
+
+    /// The settings.
+    pub fn params(&self) -> &WorldParams {
+        &self.params
+    }
+
+    /// Replaces the settings (validated).
+    pub fn set_params(&mut self, params: WorldParams) -> Result<()> {
+        Self::check_params(&params)?;
+        self.params = params;
+        Ok(())
+    }
+
+    /// Selects the solver.
+    pub fn set_solver(&mut self, kind: SolverKind) {
+        self.params.solver.kind = kind;
+    }
+
+    /// The bodies.
+    pub fn bodies(&self) -> &BodySet {
+        &self.bodies
+    }
+
+    /// The bodies, mutable (forces, impulses, velocities, poses).
+    pub fn bodies_mut(&mut self) -> &mut BodySet {
+        &mut self.bodies
+    }
+
+    /// The joints.
+    pub fn joints(&self) -> &JointSet {
+        &self.joints
+    }
+
+    /// Creates a body.
+    pub fn create_body(&mut self, desc: &BodyDesc) -> Result<BodyHandle> {
+        self.bodies.insert(desc)
+    }
+
+    /// Removes a body and every joint attached to it; returns the removed joints.
+    pub fn remove_body(&mut self, h: BodyHandle) -> Result<Vec<JointHandle>> {
+        self.bodies.slot(h)?;
+        let attached: Vec<JointHandle> = self
+            .joints
+            .iter()
+            .filter(|(_, j)| j.desc.body_a == h || j.desc.body_b == h)
+            .map(|(jh, _)| jh)
+            .collect();
+        for &jh in &attached {
+            self.joints.remove(jh)?;
+        }
+        self.bodies.remove(h)?;
+        Ok(attached)
+    }
+
+    /// Creates a joint between two live bodies.
+    pub fn create_joint(&mut self, desc: &JointDesc) -> Result<JointHandle> {
+        desc.validate()?;
+        let a = self.bodies.slot(desc.body_a)?;
+        let b = self.bodies.slot(desc.body_b)?;
+        let info = |i: usize| self.bodies.info[i].body_type;
+        if info(a) != BodyType::Dynamic && info(b) != BodyType::Dynamic {
+            return Err(CaromError::invalid(
+                "joint.body_b",
+                desc.body_b,
+                "a joint needs at least one dynamic body",
+            ));
+        }
+        self.bodies.wake_slot(a);
+        self.bodies.wake_slot(b);
+        Ok(self.joints.insert(desc.clone()))
+    }
+
+    /// Removes a joint (wakes its bodies).
+    pub fn remove_joint(&mut self, h: JointHandle) -> Result<()> {
+        let j = self.joints.remove(h)?;
+        for body in [j.desc.body_a, j.desc.body_b] {
+            if let Ok(i) = self.bodies.slot(body) {
+                self.bodies.wake_slot(i);
+            }
+        }
+        Ok(())
+    }
+
+    /// Whether contacts between `a` and `b` should be generated: both live, at least one
+    /// dynamic, and no joint between them disables collisions. The collision side filters its
+    /// pairs with this.
+    pub fn should_collide(&self, a: BodyHandle, b: BodyHandle) -> bool {
+        let (Ok(ia), Ok(ib)) = (self.bodies.slot(a), self.bodies.slot(b)) else {
+            return false;
+        };
+        let dynamic = |i: usize| self.bodies.info[i].body_type == BodyType::Dynamic;
+        a != b && (dynamic(ia) || dynamic(ib)) && !self.joints.collision_disabled(a, b)
+    }
+
+    /// Advances the world by `dt` with the given contacts. Reads the accumulated impulses of
+    /// each manifold (warm start) and writes this step's back. All input is validated before
+    /// anything changes.
+    pub fn step(&mut self, dt: Real, contacts: &mut [ContactManifold]) -> Result<StepReport> {
+        let start = Instant::now();
+        if !(dt.is_finite() && dt > 0.0) {
+            return Err(CaromError::invalid("dt", dt, "must be finite and > 0"));
+        }
+        for (k, m) in contacts.iter().enumerate() {
+            m.validate(k, &self.bodies)?;
+        }
+        for (jh, j) in self.joints.iter() {
+            if !self.bodies.contains(j.desc.body_a) || !self.bodies.contains(j.desc.body_b) {
+                return Err(CaromError::UnknownHandle(format!("a body of joint {jh:?}")));
+            }
+        }
+        let mut report = StepReport::default();
+        let roots = island::build(&self.bodies, contacts, &self.joints);
+        report.woken = island::wake_islands(&mut self.bodies, &roots, contacts);
+        report.timings.islands = start.elapsed();
+
+        integrate::load(&self.bodies, &mut self.solver_bodies);
+        let mut ctx = StepContext {
+            set: &mut self.bodies,
+            bodies: &mut self.solver_bodies,
+            manifolds: contacts,
+            joints: &mut self.joints,
+            gravity: self.params.gravity,
+            dt,
+            params: &self.params.solver,
+            gyroscopic: self.params.gyroscopic,
+            parallel: self.params.parallel,
+            timings: &mut report.timings,
+        };
+        match self.params.solver.kind {
+            SolverKind::SequentialImpulse => solver::sequential::step(&mut ctx),
+            SolverKind::SoftStep => solver::soft_step::step(&mut ctx),
+        }
+
+        let t = Instant::now();
+        integrate::store(&mut self.bodies, &self.solver_bodies);
+        for (jh, j) in self.joints.iter_mut() {
+            let peak = j.impulses.iter().fold(0.0 as Real, |m, x| m.max(x.abs()));
+            if !j.broken && peak > j.desc.break_impulse {
+                j.broken = true;
+                report.broken_joints.push(jh);
+            }
+        }
+        report.slept = island::update_sleep(&mut self.bodies, &roots, dt, &self.params.sleep);
+        report.timings.store += t.elapsed();
+        report.timings.total = start.elapsed();
+        Ok(report)
+    }
+
+    /// A hash of every body's position, rotation and velocities (bit patterns), for
+    /// determinism checks.
+    pub fn state_hash(&self) -> u64 {
+        let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+        let mut eat = |x: Real| {
+            for byte in x.to_le_bytes() {
+                h ^= byte as u64;
+                h = h.wrapping_mul(0x0000_0100_0000_01b3);
+            }
+        };
+        let b = &self.bodies;
+        for i in 0..b.capacity() {
+            let q = b.rotation[i];
+            for v in [b.position[i], b.linear_velocity[i], b.angular_velocity[i]] {
+                v.to_array().into_iter().for_each(&mut eat);
+            }
+            q.to_array().into_iter().for_each(&mut eat);
+        }
+        h
+    }
+}
