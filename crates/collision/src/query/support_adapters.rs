@@ -27,7 +27,33 @@ pub struct Exact<'a>(pub ConvexRef<'a>);
 impl Support for Exact<'_> {
     #[inline]
     fn support(&self, dir: Vec3) -> Vec3 {
-        self.0.support(dir)
+        match self.0 {
+            ConvexRef::Cone(c) => cone_support_rim_first(c, dir),
+            other => other.support(dir),
+        }
+    }
+}
+
+/// A cone's exact support that prefers the base rim when the apex and the rim tie within
+/// round-off. Every lateral-surface normal is perpendicular to a generator, so near a cone's
+/// side the apex and the rim point tie; returning the apex every time stalls GJK (the apex is
+/// already in the simplex), while the rim point at the query angle makes progress.
+#[inline]
+fn cone_support_rim_first(c: &crate::shape::Cone, dir: Vec3) -> Vec3 {
+    let (r, h) = (c.radius(), c.half_height());
+    let radial = Vec3::new(dir.x, 0.0, dir.z);
+    let len = radial.length();
+    let rim = if len > 0.0 {
+        Vec3::new(dir.x * r / len, -h, dir.z * r / len)
+    } else {
+        Vec3::new(r, -h, 0.0)
+    };
+    let apex = Vec3::new(0.0, h, 0.0);
+    let slack = 16.0 * crate::math::EPSILON * (r + h) * dir.length();
+    if apex.dot(dir) > rim.dot(dir) + slack {
+        apex
+    } else {
+        rim
     }
 }
 
