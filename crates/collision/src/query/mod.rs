@@ -27,3 +27,7 @@ pub mod ray;
 pub use ray::{raycast, raycast_local, Ray};
 pub mod point;
 pub use point::{contains_point, project_point, project_point_local};
+pub mod shape_cast;
+pub use shape_cast::{shape_cast, shape_cast_local};
+pub mod toi;
+pub use toi::{time_of_impact, Motion};

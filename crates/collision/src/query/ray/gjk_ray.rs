@@ -149,8 +149,14 @@ pub fn gjk_raycast<S: SupportPair>(
         })
     };
     let inside = lambda == 0.0;
+    // With a margin, the final closest vector (length ≈ radius) is the exact normal of the
+    // rounded surface at x; without one it vanishes, and the last support plane's normal
+    // (the one x was advanced onto) is the surface normal.
+    let vlen = v.length();
     let normal = if inside {
         -dir.normalize_or_zero()
+    } else if radius > 0.0 && vlen > 0.5 * radius {
+        v / vlen
     } else {
         normal.normalize_or_zero()
     };
