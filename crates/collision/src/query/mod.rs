@@ -31,3 +31,8 @@ pub mod shape_cast;
 pub use shape_cast::{shape_cast, shape_cast_local};
 pub mod toi;
 pub use toi::{time_of_impact, Motion};
+pub mod batch;
+pub use batch::{
+    contact_batch, distance_batch, intersects_batch, project_point_batch, raycast_batch,
+    shape_cast_batch,
+};
