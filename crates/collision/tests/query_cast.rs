@@ -224,3 +224,50 @@ fn cast_edge_cases() {
         .distance;
     assert!(d <= 1e-4 && d > -1e-3, "{d}");
 }
+
+#[test]
+fn extreme_values_stay_finite_and_terminate() {
+    use carom_collision::query::{project_point, raycast};
+    let mut rng = Rng(23);
+    let shapes = [
+        Shape::Cuboid(Cuboid::new(Vec3::new(1e-4, 1e3, 1.0)).unwrap()),
+        Shape::ConvexHull(random_hull(&mut rng, 8, 1e-3)),
+        Shape::Cylinder(Cylinder::new(1e3, 1e-3).unwrap()),
+        Shape::Capsule(Capsule::new(1e-4, 1e2).unwrap()),
+        Shape::Cone(Cone::new(1e2, 1e-2).unwrap()),
+    ];
+    for a in &shapes {
+        for mag in [0.0 as Real, 1e-6, 1.0, 1e3, 1e5] {
+            let o = rng.unit() * mag;
+            let d = rng.unit();
+            for solid in [true, false] {
+                if let Some(h) =
+                    raycast(a, &Isometry::IDENTITY, o, d, Real::INFINITY, solid).unwrap()
+                {
+                    assert!(
+                        h.distance.is_finite() && h.point.is_finite() && h.normal.is_finite(),
+                        "{h:?}"
+                    );
+                }
+            }
+            let p = project_point(a, &Isometry::IDENTITY, o).unwrap();
+            assert!(
+                p.distance.is_finite() && p.point.is_finite(),
+                "{} {p:?}",
+                a.kind_name()
+            );
+            for b in &shapes {
+                let pb = Isometry::new(o, rng.quat());
+                let v = rng.unit() * mag;
+                if let Some(h) =
+                    shape_cast(a, &Isometry::IDENTITY, Vec3::ZERO, b, &pb, v, 1.0).unwrap()
+                {
+                    assert!(
+                        h.toi.is_finite() && h.point_a.is_finite() && h.normal.is_finite(),
+                        "{h:?}"
+                    );
+                }
+            }
+        }
+    }
+}
