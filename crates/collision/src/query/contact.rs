@@ -11,7 +11,7 @@
 use super::contact_convex::{contact_convex, intersects_convex, swap_contact};
 use super::result::Contact;
 use crate::error::{CaromError, Result};
-use crate::math::{check_isometry, Isometry, Real};
+use crate::math::{Isometry, Real};
 use crate::shape::{ConvexRef, Plane, Shape, SupportMap, Triangle};
 
 /// Contact between `a` at `pose_a` and `b` at `pose_b` (world frame): `None` when they are
@@ -24,8 +24,8 @@ pub fn contact(
     pose_b: &Isometry,
     prediction: Real,
 ) -> Result<Option<Contact>> {
-    let pose_a = check_isometry("pose_a", *pose_a)?;
-    let pose_b = check_isometry("pose_b", *pose_b)?;
+    let pose_a = crate::query::check_pose("pose_a", pose_a)?;
+    let pose_b = crate::query::check_pose("pose_b", pose_b)?;
     if prediction.is_nan() {
         return Err(CaromError::invalid(
             "prediction",
@@ -47,8 +47,8 @@ pub fn distance(a: &Shape, pose_a: &Isometry, b: &Shape, pose_b: &Isometry) -> R
 /// True when the shapes touch or overlap. Convex pairs use GJK with an early exit on the
 /// first separating axis.
 pub fn intersects(a: &Shape, pose_a: &Isometry, b: &Shape, pose_b: &Isometry) -> Result<bool> {
-    let pose_a = check_isometry("pose_a", *pose_a)?;
-    let pose_b = check_isometry("pose_b", *pose_b)?;
+    let pose_a = crate::query::check_pose("pose_a", pose_a)?;
+    let pose_b = crate::query::check_pose("pose_b", pose_b)?;
     let pose_ab = pose_a.inv_mul(&pose_b);
     match (a.as_convex(), b.as_convex()) {
         (Some(ca), Some(cb)) => Ok(intersects_convex(ca, cb, &pose_ab)),

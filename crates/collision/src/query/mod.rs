@@ -36,3 +36,22 @@ pub use batch::{
     contact_batch, distance_batch, intersects_batch, project_point_batch, raycast_batch,
     shape_cast_batch,
 };
+
+use crate::math::{check_isometry, Isometry, UNIT_QUAT_TOLERANCE};
+
+/// Validates a pose like [`check_isometry`] without building error names on the happy path
+/// (queries are called millions of times; the error path allocates only on failure).
+#[inline]
+pub(crate) fn check_pose(name: &str, pose: &Isometry) -> crate::Result<Isometry> {
+    let len = pose.rotation.length();
+    if pose.translation.is_finite()
+        && pose.rotation.is_finite()
+        && (len - 1.0).abs() <= UNIT_QUAT_TOLERANCE
+    {
+        if len == 1.0 {
+            return Ok(*pose);
+        }
+        return Ok(Isometry::new(pose.translation, pose.rotation / len));
+    }
+    check_isometry(name, *pose)
+}

@@ -11,12 +11,12 @@ use super::gjk::{gjk, GjkResult};
 use super::result::PointProjection;
 use super::support_adapters::{Exact, PointSupport};
 use crate::error::Result;
-use crate::math::{check_finite_vec, check_isometry, Isometry, Real, Vec3};
+use crate::math::{check_finite_vec, Isometry, Real, Vec3};
 use crate::shape::{ConvexHull, ConvexRef, Shape};
 
 /// Projects the world point `point` on `shape` at `pose`.
 pub fn project_point(shape: &Shape, pose: &Isometry, point: Vec3) -> Result<PointProjection> {
-    let pose = check_isometry("pose", *pose)?;
+    let pose = crate::query::check_pose("pose", pose)?;
     let point = check_finite_vec("point", point)?;
     let local = project_point_local(shape, pose.inverse_transform_point(point));
     Ok(PointProjection {

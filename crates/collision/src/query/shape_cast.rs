@@ -8,7 +8,7 @@ use super::ray::gjk_ray::gjk_raycast;
 use super::result::{Contact, ShapeCastHit};
 use super::support_adapters::{core_radius, Core, MinkowskiDiff, Transformed};
 use crate::error::{CaromError, Result};
-use crate::math::{check_finite_vec, check_isometry, Isometry, Real, Vec3};
+use crate::math::{check_finite_vec, Isometry, Real, Vec3};
 use crate::shape::{ConvexRef, Shape, Triangle};
 
 /// Casts `a` (at `pose_a`, moving by `vel_a` per unit time) and `b` (at `pose_b`, moving by
@@ -24,8 +24,8 @@ pub fn shape_cast(
     vel_b: Vec3,
     max_toi: Real,
 ) -> Result<Option<ShapeCastHit>> {
-    let pose_a = check_isometry("pose_a", *pose_a)?;
-    let pose_b = check_isometry("pose_b", *pose_b)?;
+    let pose_a = crate::query::check_pose("pose_a", pose_a)?;
+    let pose_b = crate::query::check_pose("pose_b", pose_b)?;
     let vel_a = check_finite_vec("vel_a", vel_a)?;
     let vel_b = check_finite_vec("vel_b", vel_b)?;
     if max_toi.is_nan() || max_toi < 0.0 {

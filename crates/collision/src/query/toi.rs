@@ -11,7 +11,7 @@
 use super::contact::contact_local;
 use super::result::ShapeCastHit;
 use crate::error::{CaromError, Result};
-use crate::math::{check_finite_vec, check_isometry, Isometry, Quat, Real, Vec3};
+use crate::math::{check_finite_vec, Isometry, Quat, Real, Vec3};
 use crate::shape::Shape;
 
 /// Iteration cap of conservative advancement.
@@ -33,7 +33,7 @@ impl Motion {
     /// A motion; the pose is checked and velocities must be finite.
     pub fn new(pose: Isometry, linvel: Vec3, angvel: Vec3) -> Result<Motion> {
         Ok(Motion {
-            pose: check_isometry("pose", pose)?,
+            pose: crate::query::check_pose("pose", &pose)?,
             linvel: check_finite_vec("linvel", linvel)?,
             angvel: check_finite_vec("angvel", angvel)?,
         })

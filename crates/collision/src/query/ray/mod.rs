@@ -22,7 +22,7 @@ use self::gjk_ray::{gjk_raycast, Single};
 use super::result::RayHit;
 use super::support_adapters::Exact;
 use crate::error::{CaromError, Result};
-use crate::math::{check_finite_vec, check_isometry, Isometry, Real, Vec3};
+use crate::math::{check_finite_vec, Isometry, Real, Vec3};
 use crate::shape::{ConvexRef, Shape};
 
 /// A ray: `origin + t·dir` for `t` in `[0, max_distance]`, `dir` of unit length.
@@ -62,7 +62,7 @@ pub fn raycast(
     max_distance: Real,
     solid: bool,
 ) -> Result<Option<RayHit>> {
-    let pose = check_isometry("pose", *pose)?;
+    let pose = crate::query::check_pose("pose", pose)?;
     let ray = Ray::new(origin, dir)?;
     if max_distance.is_nan() || max_distance < 0.0 {
         return Err(CaromError::invalid(
