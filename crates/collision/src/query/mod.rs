@@ -7,6 +7,25 @@
 //! Conventions: see [`result`]. Functions taking [`crate::shape::Shape`]s and world poses
 //! validate their input and return [`crate::Result`]; the `*_local` / `*_convex` forms work in
 //! A's frame with `pose_ab` and skip validation (hot paths of the narrowphase).
+//!
+//! # Measured accuracy
+//!
+//! From the oracle tests in `crates/collision/tests/` (shapes of size ~1):
+//!
+//! | query | oracle | f32 | f64 |
+//! |---|---|---|---|
+//! | hull–hull distance (GJK) | vertex–face and edge–edge enumeration | 1.2e-6 relative | 1.8e-15 relative |
+//! | hull–hull depth (EPA) | minimum over all SAT axes | 3e-7 absolute | 7e-16 absolute |
+//! | box–box (SAT) | SAT oracle and GJK/EPA | < 2e-3 (test tolerance 10·2e-4) | < 1e-8 |
+//! | sphere/capsule/box pairs | closed forms | < 2e-4 | < 1e-9 |
+//! | ray casts | bisection on an independent inside test | < 2e-4 | < 1e-7 |
+//! | shape cast | bisection on the signed distance | < 1e-3 | < 1e-6 |
+//!
+//! Polytope pairs are exact up to round-off (GJK and EPA terminate on repeated support
+//! points). Curved shapes without a closed form (cylinders, cones, scaled shapes) converge
+//! to the relative tolerances of [`gjk`] and [`epa`] or stop at the iteration caps; EPA on
+//! them is the least accurate query (swapping A and B changes the depth by at most 3.3e-6 in
+//! f32 in the invariant test, checked at 1e-4).
 
 pub mod epa;
 pub mod gjk;
