@@ -184,7 +184,7 @@ fn bench_queries(c: &mut Criterion) {
             .collect();
         let pose_b = Isometry::IDENTITY;
         let ppose_b = pp(&pose_b);
-        let mut g = c.benchmark_group(format!("raycast/{}", case.b.kind_name().replace(' ', "_")));
+        let mut g = c.benchmark_group(format!("raycast/{}(B)", case.name));
         g.bench_function("carom", |bch| {
             bch.iter(|| {
                 for (o, d) in &rays {
