@@ -46,6 +46,7 @@ fn pv(v: Vec3) -> PVec3 {
     PVec3::new(a[0] as f32, a[1] as f32, a[2] as f32)
 }
 
+#[allow(clippy::unnecessary_cast)] // a no-op in the f32 build, a conversion in the f64 build
 fn pp(p: &Isometry) -> PPose {
     let q = p.rotation.to_array().map(|x| x as f32);
     PPose::from_parts(pv(p.translation), parry3d::math::Rot3::from_array(q))
