@@ -14,6 +14,7 @@
 
 pub mod error;
 pub mod math;
+pub mod query;
 pub mod shape;
 
 pub use error::{CaromError, Result};
