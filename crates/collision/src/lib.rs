@@ -12,6 +12,7 @@
 #![warn(missing_docs)]
 #![deny(unsafe_code)]
 
+pub mod broadphase;
 pub mod error;
 pub mod math;
 pub mod shape;
