@@ -16,5 +16,6 @@ pub mod broadphase;
 pub mod error;
 pub mod math;
 pub mod shape;
+pub mod world;
 
 pub use error::{CaromError, Result};

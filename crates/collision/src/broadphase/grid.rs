@@ -185,7 +185,7 @@ pub fn oversize_pairs(
 pub struct HashGrid {
     store: ProxyStore,
     cache: PairCache,
-    /// Fixed cell size; `None` picks the mean largest box extent at each update.
+    /// Fixed cell size; `None` picks the median largest box extent at each update.
     pub cell_size: Option<Real>,
     scratch: Vec<CellEntry>,
 }
@@ -225,13 +225,19 @@ impl BroadPhase for HashGrid {
         let live = self.store.live_indices();
         let boxes = self.store.aabbs();
         let cell = self.cell_size.unwrap_or_else(|| {
-            let sum: Real = live
+            // The median largest extent: robust to a few huge boxes (planes).
+            let mut ext: Vec<Real> = live
                 .iter()
                 .map(|&i| boxes[i as usize].extents().max_element())
-                .sum();
-            let mean = sum / live.len().max(1) as Real;
-            if mean > 0.0 && mean.is_finite() {
-                mean
+                .collect();
+            let m = ext.len() / 2;
+            let median = if ext.is_empty() {
+                0.0
+            } else {
+                *ext.select_nth_unstable_by(m, |a, b| a.total_cmp(b)).1
+            };
+            if median > 0.0 && median.is_finite() {
+                median
             } else {
                 1.0
             }

@@ -8,13 +8,13 @@
 //! occupied coarser levels ([`GridLevel::query`]); each pair is reported once, by its smaller
 //! box, in the lowest common cell.
 
-use super::grid::{CellEntry, GridLevel};
+use super::grid::{oversize_pairs, CellEntry, GridLevel};
 use super::{impl_common_broadphase, BroadPhase, Filter, PairCache, PairChanges};
 use super::{ProxyHandle, ProxyStore};
 use crate::error::Result;
 use crate::math::{Aabb, Real, Vec3};
 
-/// At most this many levels (sizes spanning a factor 2³² between the smallest and largest).
+/// At most this many levels (sizes spanning a factor 2³¹ above the smallest).
 const MAX_LEVELS: usize = 32;
 
 /// The hierarchical grid broadphase (see the module docs).
@@ -63,21 +63,25 @@ impl BroadPhase for HierarchicalGrid {
         let live = self.store.live_indices();
         let boxes = self.store.aabbs();
         let ext = |i: u32| boxes[i as usize].extents().max_element();
-        let largest = live.iter().map(|&i| ext(i)).fold(0.0, Real::max);
         let smallest = live
             .iter()
             .map(|&i| ext(i))
             .filter(|&e| e > 0.0)
             .fold(Real::INFINITY, Real::min);
-        // Base cell size: the smallest positive extent, bounded so the levels fit.
-        let base = if smallest.is_finite() {
-            smallest.max(largest / (2.0 as Real).powi(MAX_LEVELS as i32 - 1))
-        } else {
-            1.0
-        };
+        // Base cell size: the smallest positive extent. Boxes too large for the top level
+        // (e.g. planes' huge boxes) go to the oversize list.
+        let base = if smallest.is_finite() { smallest } else { 1.0 };
+        let top = base * (2.0 as Real).powi(MAX_LEVELS as i32 - 1);
         let mut by_level: Vec<Vec<u32>> = vec![Vec::new(); MAX_LEVELS];
+        let mut big = Vec::new();
+        let mut is_big = vec![false; self.store.capacity()];
         for &i in &live {
             let e = ext(i);
+            if e > top || !top.is_finite() {
+                big.push(i);
+                is_big[i as usize] = true;
+                continue;
+            }
             let mut l = 0;
             let mut size = base;
             while size < e && l + 1 < MAX_LEVELS {
@@ -103,6 +107,7 @@ impl BroadPhase for HierarchicalGrid {
                 }
             }
         }
+        oversize_pairs(boxes, &big, &live, &is_big, &mut keys);
         self.cache.replace(&mut self.store, keys, false)
     }
 
