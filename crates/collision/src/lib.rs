@@ -12,9 +12,11 @@
 #![warn(missing_docs)]
 #![deny(unsafe_code)]
 
+pub mod broadphase;
 pub mod error;
 pub mod math;
 pub mod query;
 pub mod shape;
+pub mod world;
 
 pub use error::{CaromError, Result};
