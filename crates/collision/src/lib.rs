@@ -16,6 +16,7 @@ pub mod broadphase;
 pub mod error;
 pub mod math;
 pub mod query;
+pub mod midphase;
 pub mod shape;
 pub mod world;
 

@@ -20,6 +20,8 @@ mod types {
     pub type Real = f32;
     /// A 3D vector of [`Real`].
     pub type Vec3 = glam::Vec3;
+    /// A 16-byte aligned (SIMD) 3D vector of [`Real`] for hot loops; [`Vec3`] itself in `f64`.
+    pub type Vec3A = glam::Vec3A;
     /// A quaternion of [`Real`] (`x, y, z, w`).
     pub type Quat = glam::Quat;
     /// A 3x3 column-major matrix of [`Real`].
@@ -34,6 +36,8 @@ mod types {
     pub type Real = f64;
     /// A 3D vector of [`Real`].
     pub type Vec3 = glam::DVec3;
+    /// A 16-byte aligned (SIMD) 3D vector of [`Real`] for hot loops; [`Vec3`] itself in `f64`.
+    pub type Vec3A = glam::DVec3;
     /// A quaternion of [`Real`] (`x, y, z, w`).
     pub type Quat = glam::DQuat;
     /// A 3x3 column-major matrix of [`Real`].
@@ -65,6 +69,7 @@ pub fn vec3_from_f64(v: [f64; 3]) -> Vec3 {
 
 /// Converts a [`Vec3`] to `[f64; 3]`.
 #[inline]
+#[allow(clippy::unnecessary_cast)] // a no-op in the f64 build
 pub fn vec3_to_f64(v: Vec3) -> [f64; 3] {
     [v.x as f64, v.y as f64, v.z as f64]
 }

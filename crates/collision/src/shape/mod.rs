@@ -12,6 +12,7 @@ mod convex_hull;
 mod cuboid;
 mod cylinder;
 mod mass;
+mod mesh_load;
 mod plane;
 mod quickhull;
 mod scaled;
@@ -19,6 +20,7 @@ mod sphere;
 mod support;
 mod triangle;
 mod trimesh;
+mod trimesh_edges;
 
 pub use capsule::Capsule;
 pub use compound::Compound;
@@ -33,7 +35,10 @@ pub use scaled::Scaled;
 pub use sphere::Sphere;
 pub use support::SupportMap;
 pub use triangle::Triangle;
-pub use trimesh::TriMesh;
+pub use trimesh::{TriMesh, TriMeshOptions};
+pub use trimesh_edges::{
+    compute_edges, weld_vertices, EdgeKind, MeshEdge, DEFAULT_FLAT_ANGLE, NO_NEIGHBOR,
+};
 
 use crate::error::{CaromError, Result};
 use crate::math::{check_positive, Aabb, Isometry, Real, Vec3};

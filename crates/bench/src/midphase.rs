@@ -1,0 +1,257 @@
+//! `carom-bench midphase`: BVH build time, bytes per triangle and closest-hit ray casts per
+//! second on the landscape mesh and a generated ~1M-triangle mesh, beside parry3d's `TriMesh`
+//! on the same meshes and rays in the same run (single thread and all threads).
+//!
+//! Options: `--rays N` (rays per mesh, default 200000), `--grid N` (cells per side of the
+//! generated mesh, default 708 → 1,002,528 triangles), `--runs N` (timing repeats, median).
+
+use carom_collision::math::{Aabb, Real, Vec3};
+use carom_collision::midphase::{triangle_aabbs, Bvh, BvhLayout};
+use carom_collision::shape::{TriMesh, TriMeshOptions};
+use parry3d::query::RayCast;
+use rayon::prelude::*;
+use std::time::Instant;
+
+type PVec = parry3d::math::Vector;
+
+struct Args {
+    rays: usize,
+    grid: usize,
+    runs: usize,
+}
+
+fn parse_args(args: &[String]) -> Args {
+    let mut a = Args {
+        rays: 200_000,
+        grid: 708,
+        runs: 3,
+    };
+    let mut it = args.iter();
+    while let Some(k) = it.next() {
+        let v = it.next().and_then(|v| v.parse::<usize>().ok());
+        match (k.as_str(), v) {
+            ("--rays", Some(v)) => a.rays = v.max(1),
+            ("--grid", Some(v)) => a.grid = v.max(1),
+            ("--runs", Some(v)) => a.runs = v.max(1),
+            _ => {
+                eprintln!("usage: carom-bench midphase [--rays N] [--grid N] [--runs N]");
+                std::process::exit(2);
+            }
+        }
+    }
+    a
+}
+
+/// Median wall time in seconds of `runs` calls of `f`.
+fn median_time<T>(runs: usize, mut f: impl FnMut() -> T) -> (f64, T) {
+    let mut times = Vec::new();
+    let mut last = None;
+    for _ in 0..runs {
+        let t0 = Instant::now();
+        let out = f();
+        times.push(t0.elapsed().as_secs_f64());
+        last = Some(out);
+    }
+    times.sort_by(|a, b| a.total_cmp(b));
+    (times[times.len() / 2], last.expect("runs >= 1"))
+}
+
+struct Lcg(u64);
+impl Lcg {
+    fn f(&mut self) -> Real {
+        self.0 = self
+            .0
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        ((self.0 >> 40) as f64 / (1u64 << 24) as f64) as Real
+    }
+}
+
+/// A wavy height grid of `n × n` cells (2 triangles each) over 1000 × 1000 units.
+fn generated_mesh(n: usize) -> (Vec<Vec3>, Vec<[u32; 3]>) {
+    let size = 1000.0 as Real;
+    let mut v = Vec::with_capacity((n + 1) * (n + 1));
+    for i in 0..=n {
+        for j in 0..=n {
+            let x = size * i as Real / n as Real;
+            let z = size * j as Real / n as Real;
+            let y = (x * 0.031).sin() * (z * 0.017).cos() * 40.0 + (x * 0.4 + z * 0.3).sin();
+            v.push(Vec3::new(x, y, z));
+        }
+    }
+    let w = (n + 1) as u32;
+    let mut t = Vec::with_capacity(2 * n * n);
+    for i in 0..n as u32 {
+        for j in 0..n as u32 {
+            let a = i * w + j;
+            t.push([a, a + 1, a + w]);
+            t.push([a + 1, a + w + 1, a + w]);
+        }
+    }
+    (v, t)
+}
+
+/// Rays from a sphere around the mesh toward random points of its bounding box.
+fn rays(bounds: &Aabb, n: usize) -> Vec<(Vec3, Vec3)> {
+    let mut rng = Lcg(12345);
+    let c = bounds.center();
+    let r = bounds.extents().length() * 0.75;
+    (0..n)
+        .map(|_| {
+            let d = loop {
+                let v = Vec3::new(rng.f() * 2.0 - 1.0, rng.f(), rng.f() * 2.0 - 1.0);
+                if v.length() > 0.1 && v.length() <= 1.0 {
+                    break v.normalize();
+                }
+            };
+            let origin = c + d * r;
+            let e = bounds.extents();
+            let target = bounds.min + Vec3::new(rng.f() * e.x, rng.f() * e.y, rng.f() * e.z);
+            (origin, (target - origin).normalize())
+        })
+        .collect()
+}
+
+fn pv(v: Vec3) -> PVec {
+    PVec::new(v.x as _, v.y as _, v.z as _)
+}
+
+fn bench_mesh(name: &str, v: Vec<Vec3>, t: Vec<[u32; 3]>, args: &Args) {
+    let ntri = t.len();
+    let per_m = 1.0e6 / ntri as f64;
+    println!("\n### {name}: {} vertices, {ntri} triangles", v.len());
+    // Build: our BVH alone (triangle boxes + binned SAH + layout), and the whole TriMesh.
+    let (t_bvh, bvh) = median_time(args.runs, || {
+        Bvh::new(&triangle_aabbs(&v, &t), BvhLayout::Quantized).expect("valid mesh")
+    });
+    let (t_bvh_u, bvh_u) = median_time(args.runs, || {
+        Bvh::new(&triangle_aabbs(&v, &t), BvhLayout::Unquantized).expect("valid mesh")
+    });
+    let (t_mesh, mesh) = median_time(args.runs, || {
+        TriMesh::with_options(v.clone(), t.clone(), TriMeshOptions::default()).expect("valid")
+    });
+    let pverts: Vec<PVec> = v.iter().map(|p| pv(*p)).collect();
+    let (t_parry, pmesh) = median_time(args.runs, || {
+        parry3d::shape::TriMesh::new(pverts.clone(), t.clone()).expect("valid mesh")
+    });
+    let uq = TriMesh::with_options(
+        v.clone(),
+        t.clone(),
+        TriMeshOptions {
+            layout: BvhLayout::Unquantized,
+            ..Default::default()
+        },
+    )
+    .expect("valid");
+    let rays = rays(&mesh.local_aabb(), args.rays);
+    let max_t = 1.0e30 as Real;
+    let (t_ours, hits_ours) = median_time(args.runs, || {
+        rays.iter()
+            .filter(|(o, d)| mesh.raycast(*o, *d, max_t).is_some())
+            .count()
+    });
+    let (t_uq, hits_uq) = median_time(args.runs, || {
+        rays.iter()
+            .filter(|(o, d)| uq.raycast(*o, *d, max_t).is_some())
+            .count()
+    });
+    let prays: Vec<parry3d::query::Ray> = rays
+        .iter()
+        .map(|(o, d)| parry3d::query::Ray::new(pv(*o), pv(*d)))
+        .collect();
+    let (t_parry_r, hits_parry) = median_time(args.runs, || {
+        prays
+            .iter()
+            .filter(|r| {
+                pmesh
+                    .cast_local_ray_and_get_normal(r, max_t as _, false)
+                    .is_some()
+            })
+            .count()
+    });
+    let (t_ours_mt, _) = median_time(args.runs, || {
+        rays.par_iter()
+            .filter(|(o, d)| mesh.raycast(*o, *d, max_t).is_some())
+            .count()
+    });
+    let (t_parry_mt, _) = median_time(args.runs, || {
+        prays
+            .par_iter()
+            .filter(|r| {
+                pmesh
+                    .cast_local_ray_and_get_normal(r, max_t as _, false)
+                    .is_some()
+            })
+            .count()
+    });
+    let n = rays.len() as f64;
+    let threads = rayon::current_num_threads();
+    println!(
+        "hits: carom {hits_ours}, carom-unquantised {hits_uq}, parry {hits_parry} of {} rays",
+        rays.len()
+    );
+    println!(
+        "| metric | carom (quantised) | carom (unquantised) | parry3d 0.31.1 | carom / parry |"
+    );
+    println!("|---|---|---|---|---|");
+    println!(
+        "| BVH build, ms per 1M tri | {:.0} | {:.0} | {:.0} (whole TriMesh::new) | {:.2}x faster |",
+        t_bvh * per_m * 1e3,
+        t_bvh_u * per_m * 1e3,
+        t_parry * per_m * 1e3,
+        t_parry / t_bvh
+    );
+    println!(
+        "| TriMesh::new (BVH + edges), ms per 1M tri | {:.0} | | {:.0} | {:.2}x |",
+        t_mesh * per_m * 1e3,
+        t_parry * per_m * 1e3,
+        t_parry / t_mesh
+    );
+    println!(
+        "| BVH bytes per triangle | {:.1} | {:.1} | {:.1} | |",
+        bvh.memory_bytes() as f64 / ntri as f64,
+        bvh_u.memory_bytes() as f64 / ntri as f64,
+        pmesh.bvh().total_memory_size() as f64 / ntri as f64
+    );
+    println!(
+        "| closest-hit rays/s, 1 thread | {:.2}M | {:.2}M | {:.2}M | {:.2}x |",
+        n / t_ours / 1e6,
+        n / t_uq / 1e6,
+        n / t_parry_r / 1e6,
+        t_parry_r / t_ours
+    );
+    println!(
+        "| closest-hit rays/s, {threads} threads | {:.2}M | | {:.2}M | {:.2}x |",
+        n / t_ours_mt / 1e6,
+        n / t_parry_mt / 1e6,
+        t_parry_mt / t_ours_mt
+    );
+    println!(
+        "| thread scaling (mt / 1 thread) | {:.2}x | | {:.2}x | |",
+        t_ours / t_ours_mt,
+        t_parry_r / t_parry_mt
+    );
+}
+
+/// Entry point of the subcommand.
+pub fn run(args: &[String]) {
+    let args = parse_args(args);
+    println!(
+        "carom-bench midphase: {} rays per mesh, median of {} runs, {} rayon threads",
+        args.rays,
+        args.runs,
+        rayon::current_num_threads()
+    );
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../scenes/data/landscape.obj");
+    match TriMesh::load(path) {
+        Ok(m) => bench_mesh(
+            "landscape.obj",
+            m.vertices().to_vec(),
+            m.indices().to_vec(),
+            &args,
+        ),
+        Err(e) => eprintln!("skipping the landscape: {e}"),
+    }
+    let (v, t) = generated_mesh(args.grid);
+    bench_mesh("generated height grid", v, t, &args);
+}

@@ -1,0 +1,399 @@
+//! A static bounding-volume hierarchy with fixed topology, in two node layouts.
+//!
+//! The layout follows Bullet's `btQuantizedBvh` (`btOptimizedBvh`) as presented in Coumans,
+//! "Optimizing Proximity Queries for CPU, SPU and GPU" (SIGGRAPH 2010): nodes in depth-first
+//! order, each either a leaf (a range of primitives) or an internal node whose left child
+//! follows it and whose *escape index* points just past its subtree, so traversal needs no
+//! stack. Quantised nodes are 16 bytes: the box as six `u16` relative to the hierarchy's
+//! bounds (minimum rounded down, maximum rounded up, so no primitive is ever missed) and one
+//! `u32` holding the escape index or the leaf's primitive range. The unquantised layout
+//! stores boxes as [`Real`]s, for comparison; both give identical query results.
+//!
+//! [`Bvh::refit`] recomputes the boxes after primitives moved without changing topology.
+
+use super::build::{build, BuildOutput};
+use crate::error::{CaromError, Result};
+use crate::math::{Aabb, Real, Vec3, EPSILON};
+use serde::{Deserialize, Serialize};
+
+/// Flag bit of a leaf's `data`.
+pub(crate) const LEAF_FLAG: u32 = 1 << 31;
+const COUNT_SHIFT: u32 = 28;
+const FIRST_MASK: u32 = (1 << COUNT_SHIFT) - 1;
+/// Largest number of primitives a [`Bvh`] can hold.
+pub const MAX_PRIMITIVES: usize = FIRST_MASK as usize;
+/// Largest quantised coordinate used for node boxes (one unit of headroom on each side).
+const QUANT_MAX: Real = 65534.0;
+
+/// Which node layout a [`Bvh`] stores.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
+pub enum BvhLayout {
+    /// 16-byte nodes with boxes quantised to `u16` (the default).
+    #[default]
+    Quantized,
+    /// Nodes with [`Real`] boxes (28 bytes in `f32`), for comparison.
+    Unquantized,
+}
+
+/// A 16-byte node: box quantised relative to the hierarchy bounds, and the escape index
+/// (internal node) or primitive range (leaf, top bit set).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub struct QuantizedNode {
+    /// Quantised lower corner (rounded down).
+    pub min: [u16; 3],
+    /// Quantised upper corner (rounded up).
+    pub max: [u16; 3],
+    /// Escape index, or `LEAF | (count - 1) << 28 | first` for a leaf.
+    pub data: u32,
+}
+
+/// A node with a [`Real`] box (padded outward by a few ulps).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct UnquantizedNode {
+    /// Lower corner.
+    pub min: [Real; 3],
+    /// Upper corner.
+    pub max: [Real; 3],
+    /// Escape index or leaf range, as in [`QuantizedNode::data`].
+    pub data: u32,
+}
+
+/// The affine map between world coordinates and quantised ones.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Quantization {
+    /// World point of quantised coordinate 0.
+    pub origin: Vec3,
+    /// Quantised units per world unit, per axis.
+    pub scale: Vec3,
+    /// World units per quantised unit.
+    pub inv_scale: Vec3,
+    /// Outward padding of dequantised boxes covering the rounding of `origin + q * inv_scale`.
+    pub dequantize_pad: Vec3,
+}
+
+impl Quantization {
+    /// The quantisation of `bounds`, grown slightly so every point of it maps strictly inside
+    /// `[1, 65534]`.
+    pub fn new(bounds: &Aabb) -> Self {
+        let size = bounds.extents().max_element();
+        let magnitude = bounds.min.abs().max(bounds.max.abs()).max_element();
+        let pad = size * 1.0e-3 + magnitude * 16.0 * EPSILON + 1.0e-6;
+        let origin = bounds.min - Vec3::splat(pad);
+        let extent = bounds.extents() + Vec3::splat(2.0 * pad);
+        let scale = Vec3::splat(QUANT_MAX - 1.0) / extent;
+        let inv_scale = extent / (QUANT_MAX - 1.0);
+        let dequantize_pad = (origin.abs() + extent) * (8.0 * EPSILON) + inv_scale * 0.01;
+        Quantization {
+            origin,
+            scale,
+            inv_scale,
+            dequantize_pad,
+        }
+    }
+
+    /// Quantised coordinates of `p` rounded down (`up = false`) or up, with one unit of
+    /// margin for rounding, clamped to `u16`.
+    #[inline]
+    pub fn quantize(&self, p: Vec3, up: bool) -> [u16; 3] {
+        let x = (p - self.origin) * self.scale;
+        let mut out = [0u16; 3];
+        for i in 0..3 {
+            let slack = 1.0 + x[i].abs() * 4.0 * EPSILON;
+            let v = if up {
+                (x[i] + slack).ceil()
+            } else {
+                (x[i] - slack).floor()
+            };
+            out[i] = v.clamp(0.0, 65535.0) as u16;
+        }
+        out
+    }
+
+    /// The world box containing the quantised box `[min, max]`.
+    #[inline]
+    pub fn dequantize(&self, min: [u16; 3], max: [u16; 3]) -> Aabb {
+        let lo = Vec3::new(min[0] as Real, min[1] as Real, min[2] as Real);
+        let hi = Vec3::new(max[0] as Real, max[1] as Real, max[2] as Real);
+        Aabb::new(
+            self.origin + lo * self.inv_scale - self.dequantize_pad,
+            self.origin + hi * self.inv_scale + self.dequantize_pad,
+        )
+    }
+}
+
+/// The nodes, in one of the two layouts.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub(crate) enum Nodes {
+    Quantized(Vec<QuantizedNode>, Quantization),
+    Unquantized(Vec<UnquantizedNode>),
+}
+
+/// A static BVH over primitive boxes (triangles, heightfield cells, compound children).
+/// Build with [`Bvh::new`]; query with the traversals of `midphase`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Bvh {
+    pub(crate) nodes: Nodes,
+    /// Primitive indices; a leaf covers a contiguous range.
+    pub(crate) order: Vec<u32>,
+    /// Exact bounds of all primitives.
+    bounds: Aabb,
+}
+
+/// Encodes a leaf's primitive range.
+#[inline]
+fn leaf_data(first: u32, count: u32) -> u32 {
+    debug_assert!((1..=8).contains(&count) && first <= FIRST_MASK);
+    LEAF_FLAG | ((count - 1) << COUNT_SHIFT) | first
+}
+
+/// Decodes a leaf's `data` into `(first, count)`.
+#[inline(always)]
+pub(crate) fn leaf_range(data: u32) -> (usize, usize) {
+    (
+        (data & FIRST_MASK) as usize,
+        (((data >> COUNT_SHIFT) & 7) + 1) as usize,
+    )
+}
+
+/// Pads a box outward by a few ulps so that a ray lying in a face plane of the exact box
+/// never produces `0 · ∞` on the padded one.
+#[inline]
+fn pad_ulps(aabb: &Aabb) -> Aabb {
+    let tiny = Real::MIN_POSITIVE;
+    Aabb::new(
+        aabb.min - (aabb.min.abs() * (4.0 * EPSILON) + Vec3::splat(tiny)),
+        aabb.max + (aabb.max.abs() * (4.0 * EPSILON) + Vec3::splat(tiny)),
+    )
+}
+
+fn check_boxes(boxes: &[Aabb]) -> Result<()> {
+    if boxes.is_empty() {
+        return Err(CaromError::invalid(
+            "boxes",
+            0usize,
+            "a BVH needs at least one primitive",
+        ));
+    }
+    if boxes.len() > MAX_PRIMITIVES {
+        return Err(CaromError::invalid(
+            "boxes.len()",
+            boxes.len(),
+            format!("a BVH holds at most {MAX_PRIMITIVES} primitives"),
+        ));
+    }
+    for (i, b) in boxes.iter().enumerate() {
+        if !b.is_valid() {
+            return Err(CaromError::invalid(
+                format!("boxes[{i}]"),
+                b,
+                "must be finite with min <= max",
+            ));
+        }
+    }
+    Ok(())
+}
+
+impl Bvh {
+    /// Builds a BVH over primitive boxes (binned SAH, see `midphase::build`). Primitive `i`
+    /// is reported as `i` by the traversals. Errors for no boxes, invalid boxes, or more
+    /// than [`MAX_PRIMITIVES`].
+    pub fn new(boxes: &[Aabb], layout: BvhLayout) -> Result<Self> {
+        check_boxes(boxes)?;
+        let BuildOutput {
+            nodes,
+            escapes,
+            order,
+        } = build(boxes);
+        let aabbs: Vec<Aabb> = nodes.iter().map(|n| n.aabb).collect();
+        let data: Vec<u32> = nodes
+            .iter()
+            .zip(&escapes)
+            .map(|(n, &e)| {
+                if n.is_leaf() {
+                    leaf_data(n.first_or_right, n.count)
+                } else {
+                    e
+                }
+            })
+            .collect();
+        let bounds = aabbs[0];
+        Ok(Bvh {
+            nodes: make_nodes(layout, &aabbs, &data, &bounds),
+            order,
+            bounds,
+        })
+    }
+
+    /// The node layout.
+    pub fn layout(&self) -> BvhLayout {
+        match self.nodes {
+            Nodes::Quantized(..) => BvhLayout::Quantized,
+            Nodes::Unquantized(_) => BvhLayout::Unquantized,
+        }
+    }
+
+    /// Number of nodes.
+    pub fn num_nodes(&self) -> usize {
+        match &self.nodes {
+            Nodes::Quantized(v, _) => v.len(),
+            Nodes::Unquantized(v) => v.len(),
+        }
+    }
+
+    /// Number of primitives.
+    pub fn num_primitives(&self) -> usize {
+        self.order.len()
+    }
+
+    /// Bytes used by the nodes and the primitive order.
+    pub fn memory_bytes(&self) -> usize {
+        let nodes = match &self.nodes {
+            Nodes::Quantized(v, _) => v.len() * std::mem::size_of::<QuantizedNode>(),
+            Nodes::Unquantized(v) => v.len() * std::mem::size_of::<UnquantizedNode>(),
+        };
+        nodes + self.order.len() * 4 + std::mem::size_of::<Self>()
+    }
+
+    /// Exact bounds of all primitives.
+    pub fn root_aabb(&self) -> Aabb {
+        self.bounds
+    }
+
+    /// The same hierarchy in another layout.
+    pub fn with_layout(&self, layout: BvhLayout) -> Bvh {
+        let (aabbs, data) = self.node_boxes_and_data();
+        Bvh {
+            nodes: make_nodes(layout, &aabbs, &data, &self.bounds),
+            order: self.order.clone(),
+            bounds: self.bounds,
+        }
+    }
+
+    /// Refits the boxes to new primitive boxes (same count, same topology), re-quantising
+    /// against the new bounds. Query results afterwards equal those of a fresh build.
+    pub fn refit(&mut self, boxes: &[Aabb]) -> Result<()> {
+        check_boxes(boxes)?;
+        if boxes.len() != self.order.len() {
+            return Err(CaromError::invalid(
+                "boxes.len()",
+                boxes.len(),
+                format!(
+                    "refit needs the {} primitives of the build",
+                    self.order.len()
+                ),
+            ));
+        }
+        let (_, data) = self.node_boxes_and_data();
+        let mut aabbs = vec![Aabb::EMPTY; data.len()];
+        for i in (0..data.len()).rev() {
+            aabbs[i] = if data[i] & LEAF_FLAG != 0 {
+                let (first, count) = leaf_range(data[i]);
+                self.order[first..first + count]
+                    .iter()
+                    .fold(Aabb::EMPTY, |acc, &p| acc.merge(&boxes[p as usize]))
+            } else {
+                aabbs[i + 1].merge(&aabbs[right_child(&data, i)])
+            };
+        }
+        self.bounds = aabbs[0];
+        self.nodes = make_nodes(self.layout(), &aabbs, &data, &self.bounds);
+        Ok(())
+    }
+
+    /// Conservative boxes and data of all nodes.
+    fn node_boxes_and_data(&self) -> (Vec<Aabb>, Vec<u32>) {
+        match &self.nodes {
+            Nodes::Quantized(v, q) => (
+                v.iter().map(|n| q.dequantize(n.min, n.max)).collect(),
+                v.iter().map(|n| n.data).collect(),
+            ),
+            Nodes::Unquantized(v) => (
+                v.iter()
+                    .map(|n| Aabb::new(Vec3::from(n.min), Vec3::from(n.max)))
+                    .collect(),
+                v.iter().map(|n| n.data).collect(),
+            ),
+        }
+    }
+}
+
+/// Right child of internal node `i`: the escape index of its left child `i + 1`.
+#[inline]
+pub(crate) fn right_child(data: &[u32], i: usize) -> usize {
+    let left = data[i + 1];
+    if left & LEAF_FLAG != 0 {
+        i + 2
+    } else {
+        left as usize
+    }
+}
+
+fn make_nodes(layout: BvhLayout, aabbs: &[Aabb], data: &[u32], bounds: &Aabb) -> Nodes {
+    match layout {
+        BvhLayout::Quantized => {
+            let q = Quantization::new(bounds);
+            let nodes = aabbs
+                .iter()
+                .zip(data)
+                .map(|(a, &d)| QuantizedNode {
+                    min: q.quantize(a.min, false),
+                    max: q.quantize(a.max, true),
+                    data: d,
+                })
+                .collect();
+            Nodes::Quantized(nodes, q)
+        }
+        BvhLayout::Unquantized => Nodes::Unquantized(
+            aabbs
+                .iter()
+                .zip(data)
+                .map(|(a, &d)| {
+                    let p = pad_ulps(a);
+                    UnquantizedNode {
+                        min: p.min.to_array(),
+                        max: p.max.to_array(),
+                        data: d,
+                    }
+                })
+                .collect(),
+        ),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn node_sizes() {
+        assert_eq!(std::mem::size_of::<QuantizedNode>(), 16);
+    }
+
+    #[test]
+    fn quantization_is_conservative() {
+        let bounds = Aabb::new(
+            Vec3::new(1.0e4, -3.0, 0.0),
+            Vec3::new(1.0e4 + 2.0, 5.0, 0.0),
+        );
+        let q = Quantization::new(&bounds);
+        for k in 0..200 {
+            let t = k as Real / 199.0;
+            let p = bounds.min + bounds.extents() * t;
+            let b = Aabb::new(p, p + bounds.extents() * 0.001 * t);
+            let d = q.dequantize(q.quantize(b.min, false), q.quantize(b.max, true));
+            assert!(d.contains(&b), "{d:?} must contain {b:?}");
+        }
+    }
+
+    #[test]
+    fn rejects_bad_boxes() {
+        assert!(Bvh::new(&[], BvhLayout::Quantized).is_err());
+        let bad = Aabb::new(Vec3::ZERO, Vec3::new(Real::NAN, 0.0, 0.0));
+        let e = Bvh::new(&[bad], BvhLayout::Quantized).unwrap_err();
+        assert!(e.to_string().contains("boxes[0]"));
+        let mut bvh = Bvh::new(&[Aabb::new(Vec3::ZERO, Vec3::ONE)], BvhLayout::Quantized).unwrap();
+        assert!(bvh.refit(&[]).is_err());
+    }
+}
