@@ -54,6 +54,7 @@ rust-test-f64: toolchain
 
 python-test: develop
 	$(PY) -m pytest -q python/tests
+	$(PY) -m mypy.stubtest carom._carom
 
 test: fmt-check lint rust-test rust-test-f64 python-test
 	@echo "make test: all checks passed"

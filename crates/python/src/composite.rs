@@ -1,0 +1,238 @@
+//! The shape classes built from many parts: `carom.ConvexHull`, `carom.TriMesh`,
+//! `carom.Compound` and `carom.Scaled`.
+//!
+//! Each constructor is the one place its core constructor is called.
+
+use crate::convert::{index_triples, indices_out, triples_out, vec3_out, vec3s, vec3s_out};
+use crate::errors::{carom_err, core};
+use crate::pose::{extract_isometry, Pose64, PyPose};
+use crate::serialize::hull_problem;
+use crate::shape::{scale_factors, PyShape};
+use crate::shapes::{init, shape_of, wrap_shape, wrong_kind};
+use carom_collision::math::Isometry;
+use carom_collision::shape::{Compound, ConvexHull, Scaled, Shape, TriMesh};
+use carom_collision::CaromError;
+use numpy::{PyArray1, PyArray2};
+use pyo3::exceptions::PyTypeError;
+use pyo3::prelude::*;
+use pyo3::types::{PyList, PyTuple};
+use std::sync::Arc;
+
+/// The convex hull of `points` `(N, 3)`: at least 4 finite points spanning a 3D volume
+/// (coplanar or collinear points raise `CaromError`). Duplicate and interior points are
+/// dropped; coplanar triangles are merged into polygonal faces. No margin.
+#[pyclass(name = "ConvexHull", module = "carom", extends = PyShape, frozen)]
+pub struct PyConvexHull;
+
+fn hull_of(slf: &Bound<'_, PyConvexHull>) -> PyResult<ConvexHull> {
+    match shape_of(slf) {
+        Shape::ConvexHull(h) => Ok(h.clone()),
+        _ => Err(wrong_kind("ConvexHull")),
+    }
+}
+
+#[pymethods]
+impl PyConvexHull {
+    #[new]
+    fn new(py: Python<'_>, points: &Bound<'_, PyAny>) -> PyResult<PyClassInitializer<Self>> {
+        let (pts, _) = vec3s(points, "points", false)?;
+        let hull = py.detach(move || core(|| ConvexHull::new(&pts)))?;
+        // Guard against degenerate hulls the core builder lets through (nearly coplanar
+        // points far from the origin can give a hull without faces or volume).
+        if let Some(reason) = hull_problem(&hull) {
+            return Err(carom_err(CaromError::degenerate(
+                "convex hull",
+                format!(
+                    "the points are (nearly) coplanar or collinear for this precision: {reason}"
+                ),
+            )));
+        }
+        Ok(init(hull.into(), PyConvexHull))
+    }
+
+    /// The hull's vertices, `(V, 3)` (only points on the hull).
+    #[getter]
+    fn vertices<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        match shape_of(slf) {
+            Shape::ConvexHull(h) => Ok(vec3s_out(slf.py(), h.vertices())),
+            _ => Err(wrong_kind("ConvexHull")),
+        }
+    }
+
+    /// The polygonal faces: a list of int64 arrays of vertex indices, each loop
+    /// counter-clockwise seen from outside.
+    #[getter]
+    fn faces<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyList>> {
+        let h = hull_of(slf)?;
+        let loops: Vec<Bound<'py, PyArray1<i64>>> = (0..h.faces().len())
+            .map(|f| indices_out(slf.py(), h.face_vertices(f)))
+            .collect();
+        PyList::new(slf.py(), loops)
+    }
+
+    /// A triangulation of the faces, `(T, 3)` int64, counter-clockwise from outside.
+    #[getter]
+    fn triangles<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyArray2<i64>>> {
+        match shape_of(slf) {
+            Shape::ConvexHull(h) => Ok(triples_out(slf.py(), h.triangles())),
+            _ => Err(wrong_kind("ConvexHull")),
+        }
+    }
+}
+
+/// A triangle mesh: `vertices` `(V, 3)` (finite) and `indices` `(T, 3)` integers in
+/// `[0, V)`, counter-clockwise triangles. Volume and mass are those of the enclosed solid for
+/// a closed, outward-oriented mesh. Not convex: no support map.
+#[pyclass(name = "TriMesh", module = "carom", extends = PyShape, frozen)]
+pub struct PyTriMesh;
+
+#[pymethods]
+impl PyTriMesh {
+    #[new]
+    fn new(
+        vertices: &Bound<'_, PyAny>,
+        indices: &Bound<'_, PyAny>,
+    ) -> PyResult<PyClassInitializer<Self>> {
+        let (verts, _) = vec3s(vertices, "vertices", false)?;
+        let tris = index_triples(indices, "indices")?;
+        Ok(init(core(|| TriMesh::new(verts, tris))?.into(), PyTriMesh))
+    }
+
+    /// The vertices, `(V, 3)`.
+    #[getter]
+    fn vertices<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        match shape_of(slf) {
+            Shape::TriMesh(m) => Ok(vec3s_out(slf.py(), m.vertices())),
+            _ => Err(wrong_kind("TriMesh")),
+        }
+    }
+
+    /// The triangles as vertex indices, `(T, 3)` int64.
+    #[getter]
+    fn indices<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyArray2<i64>>> {
+        match shape_of(slf) {
+            Shape::TriMesh(m) => Ok(triples_out(slf.py(), m.indices())),
+            _ => Err(wrong_kind("TriMesh")),
+        }
+    }
+}
+
+/// A rigid assembly of child shapes: `children` is a non-empty sequence of
+/// `(shape, pose)` pairs (a pose is a `Pose`, a `(7,)` array or `None`; a bare shape means
+/// the identity pose). Planes cannot be children. Volume and mass sum the children
+/// (overlaps count twice).
+#[pyclass(name = "Compound", module = "carom", extends = PyShape, frozen)]
+pub struct PyCompound;
+
+fn type_name(obj: &Bound<'_, PyAny>) -> String {
+    match obj.get_type().name() {
+        Ok(n) => n.to_string(),
+        Err(_) => "object".to_string(),
+    }
+}
+
+fn child(i: usize, item: &Bound<'_, PyAny>) -> PyResult<(Isometry, Arc<Shape>)> {
+    if let Ok(s) = item.cast::<PyShape>() {
+        return Ok((Isometry::IDENTITY, s.get().inner.clone()));
+    }
+    let pair = item
+        .cast::<PyTuple>()
+        .map(|t| t.as_any().clone())
+        .or_else(|_| item.cast::<PyList>().map(|l| l.as_any().clone()));
+    let pair = match pair {
+        Ok(p) if p.len()? == 2 => p,
+        _ => {
+            return Err(PyTypeError::new_err(format!(
+                "children[{i}] must be a (shape, pose) pair, got {}",
+                type_name(item)
+            )))
+        }
+    };
+    let shape = pair.get_item(0)?;
+    let shape = shape.cast::<PyShape>().map_err(|_| {
+        PyTypeError::new_err(format!(
+            "children[{i}][0] must be a carom.Shape, got {}",
+            type_name(&shape)
+        ))
+    })?;
+    let pose = extract_isometry(Some(&pair.get_item(1)?), &format!("children[{i}].pose"))?;
+    Ok((pose, shape.get().inner.clone()))
+}
+
+#[pymethods]
+impl PyCompound {
+    #[new]
+    fn new(children: &Bound<'_, PyAny>) -> PyResult<PyClassInitializer<Self>> {
+        let iter = children.try_iter().map_err(|_| {
+            PyTypeError::new_err(format!(
+                "children must be a sequence of (shape, pose) pairs, got {}",
+                type_name(children)
+            ))
+        })?;
+        let mut parts = Vec::new();
+        for (i, item) in iter.enumerate() {
+            parts.push(child(i, &item?)?);
+        }
+        Ok(init(core(|| Compound::new(parts))?.into(), PyCompound))
+    }
+
+    /// The children as a list of `(shape, Pose)` pairs (poses at the core's precision,
+    /// see `carom.REAL_BITS`).
+    #[getter]
+    fn children<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyList>> {
+        let py = slf.py();
+        let Shape::Compound(c) = shape_of(slf) else {
+            return Err(wrong_kind("Compound"));
+        };
+        let mut out = Vec::with_capacity(c.children().len());
+        for (pose, shape) in c.children() {
+            let s = wrap_shape(py, shape.clone())?;
+            let p = Bound::new(py, PyPose::new_py(Pose64::from_isometry(pose)))?;
+            out.push(PyTuple::new(py, [s, p.into_any()])?);
+        }
+        PyList::new(py, out)
+    }
+}
+
+/// A convex shape scaled along its local axes: `Scaled(shape, factors)` is
+/// `shape.scaled(factors)` (factors a scalar or `(3,)`, finite, non-zero; negative factors
+/// mirror). The support map and mass properties are exact; no margin.
+#[pyclass(name = "Scaled", module = "carom", extends = PyShape, frozen)]
+pub struct PyScaled;
+
+#[pymethods]
+impl PyScaled {
+    #[new]
+    fn new(
+        shape: &Bound<'_, PyAny>,
+        factors: &Bound<'_, PyAny>,
+    ) -> PyResult<PyClassInitializer<Self>> {
+        let inner = shape.cast::<PyShape>().map_err(|_| {
+            PyTypeError::new_err(format!(
+                "shape must be a carom.Shape, got {}",
+                type_name(shape)
+            ))
+        })?;
+        let scale = scale_factors(factors)?;
+        let inner = inner.get().inner.clone();
+        Ok(init(core(|| Scaled::new(inner, scale))?.into(), PyScaled))
+    }
+
+    /// The shape being scaled.
+    #[getter]
+    fn inner<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyAny>> {
+        match shape_of(slf) {
+            Shape::Scaled(s) => wrap_shape(slf.py(), s.inner().clone()),
+            _ => Err(wrong_kind("Scaled")),
+        }
+    }
+
+    /// The scale factors, `(3,)`.
+    #[getter]
+    fn scale<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        match shape_of(slf) {
+            Shape::Scaled(s) => Ok(vec3_out(slf.py(), s.scale())),
+            _ => Err(wrong_kind("Scaled")),
+        }
+    }
+}

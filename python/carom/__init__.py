@@ -1,0 +1,57 @@
+"""Carom: collision detection and rigid-body physics with a Rust core.
+
+Shapes (``Sphere``, ``Box``, ``Capsule``, ``Cylinder``, ``Cone``, ``ConvexHull``,
+``Triangle``, ``TriMesh``, ``Compound``, ``Plane`` and ``shape.scaled(...)``) and poses
+(``Pose``, a position and a unit quaternion ``(x, y, z, w)`` as in pybullet). Arrays go in
+and come out as float64 numpy arrays; anything ``numpy.asarray`` turns into numbers is
+accepted. Capsules, cylinders and cones lie along the local **Y** axis.
+
+Invalid values raise :class:`CaromError` (a ``ValueError``) naming the bad value; wrong
+types raise ``TypeError``.
+
+Example::
+
+    >>> import carom
+    >>> box = carom.Box([0.5, 1.0, 2.0])
+    >>> box.support([[1, 1, 1], [-1, 0, 0]])
+    array([[ 0.5,  1. ,  2. ],
+           [-0.5,  1. ,  2. ]])
+"""
+
+from carom._carom import (
+    REAL_BITS,
+    Box,
+    Capsule,
+    CaromError,
+    Compound,
+    Cone,
+    ConvexHull,
+    Cylinder,
+    Plane,
+    Pose,
+    Scaled,
+    Shape,
+    Sphere,
+    Triangle,
+    TriMesh,
+    __version__,
+)
+
+__all__ = [
+    "REAL_BITS",
+    "Box",
+    "Capsule",
+    "CaromError",
+    "Compound",
+    "Cone",
+    "ConvexHull",
+    "Cylinder",
+    "Plane",
+    "Pose",
+    "Scaled",
+    "Shape",
+    "Sphere",
+    "Triangle",
+    "TriMesh",
+    "__version__",
+]
