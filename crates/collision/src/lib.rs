@@ -15,8 +15,9 @@
 pub mod broadphase;
 pub mod error;
 pub mod math;
-pub mod query;
 pub mod midphase;
+pub mod narrowphase;
+pub mod query;
 pub mod shape;
 pub mod world;
 

@@ -22,12 +22,18 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let capsule: Arc<Shape> = Arc::new(Capsule::new(0.3, 0.5)?.into());
     let shapes: Vec<(&str, Shape)> = vec![
         ("Sphere(0.5)", Sphere::new(0.5)?.into()),
-        ("Box(1, 0.5, 0.25)", Cuboid::new(Vec3::new(1.0, 0.5, 0.25))?.into()),
+        (
+            "Box(1, 0.5, 0.25)",
+            Cuboid::new(Vec3::new(1.0, 0.5, 0.25))?.into(),
+        ),
         ("Capsule(0.3, 0.5)", (*capsule).clone()),
         ("Cylinder(0.4, 0.6)", Cylinder::new(0.4, 0.6)?.into()),
         ("Cone(0.5, 0.75)", Cone::new(0.5, 0.75)?.into()),
         ("ConvexHull(Taru)", hull.clone().into()),
-        ("Capsule scaled (2,1,0.5)", capsule.scaled(Vec3::new(2.0, 1.0, 0.5))?),
+        (
+            "Capsule scaled (2,1,0.5)",
+            capsule.scaled(Vec3::new(2.0, 1.0, 0.5))?,
+        ),
     ];
     println!(
         "{:<26} {:>10} {:>11} {:>28} {:>30}",
@@ -35,7 +41,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     );
     for (name, s) in &shapes {
         let mp = s.mass_properties(1000.0);
-        let inertia = Vec3::new(mp.inertia.x_axis.x, mp.inertia.y_axis.y, mp.inertia.z_axis.z);
+        let inertia = Vec3::new(
+            mp.inertia.x_axis.x,
+            mp.inertia.y_axis.y,
+            mp.inertia.z_axis.z,
+        );
         println!(
             "{:<26} {:>10.5} {:>11.3} {:>28} {:>30}",
             name,
@@ -69,7 +79,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
 
     println!();
     println!("== Bullet's benchmark scenes (built by carom-scenes) ==");
-    println!("{:<16} {:>8} {:>8} {:>7} {:>6} {:>11}", "scene", "dynamic", "static", "joints", "rays", "build (ms)");
+    println!(
+        "{:<16} {:>8} {:>8} {:>7} {:>6} {:>11}",
+        "scene", "dynamic", "static", "joints", "rays", "build (ms)"
+    );
     for n in 1..=8 {
         let t0 = Instant::now();
         let s = bullet::scene(n).ok_or("scene")?;

@@ -1,0 +1,20 @@
+//! Contact generation (Coumans, "Contact Generation", GDC 2010): turns overlapping pairs into
+//! persistent multi-point contact manifolds.
+//!
+//! - [`contact`]: the contact point; [`manifold`]: the persistent manifold;
+//! - [`polyhedron`] and [`box_box`]: SAT with Gauss-map pruning and face clipping for
+//!   boxes, hulls and triangles; [`convex`]: analytic manifolds for round shapes and
+//!   multi-point by perturbation; [`mesh`]: convex against triangle meshes and compounds
+//!   with internal-edge correction; [`dispatcher`]: the shape-pair table.
+
+pub mod contact;
+pub mod manifold;
+
+pub use contact::{ContactPoint, FeatureId, NO_FEATURE};
+pub use manifold::{ContactManifold, ManifoldConfig, MAX_MANIFOLD_POINTS};
+pub mod convex;
+pub mod dispatcher;
+pub mod mesh;
+pub mod polyhedron;
+
+pub use dispatcher::{Dispatcher, Generated, UserAlgorithm};
