@@ -1,4 +1,4 @@
-//! The collision world: shapes with poses and filters, a broadphase, and (later) the
+//! The collision world: shapes with poses and filters, a broadphase, and the
 //! narrowphase. Objects are named by generational handles; [`CollisionWorld::update`]
 //! recomputes the boxes of the objects that moved (`Shape::aabb(pose)`) and reports the
 //! broadphase pairs added and removed, in a deterministic order.
@@ -9,6 +9,7 @@
 use crate::broadphase::{AnyBroadPhase, BroadPhase, Filter, Method, ProxyHandle, UserFilter};
 use crate::error::{CaromError, Result};
 use crate::math::{check_isometry, Aabb, Isometry, Vec3};
+use crate::narrowphase::NarrowPhase;
 use crate::shape::Shape;
 use std::sync::Arc;
 
@@ -72,6 +73,7 @@ pub struct CollisionWorld {
     broadphase: AnyBroadPhase,
     dirty: Vec<u32>,
     changes: WorldPairChanges,
+    narrowphase: NarrowPhase<ObjectHandle>,
 }
 
 impl CollisionWorld {
@@ -108,6 +110,11 @@ impl CollisionWorld {
         filter: Filter,
     ) -> Result<ObjectHandle> {
         let pose = check_isometry("pose", pose)?;
+        if !shape.is_convex() {
+            for o in self.objects.iter().flatten() {
+                self.narrowphase.dispatcher.check_pair(&shape, &o.shape)?;
+            }
+        }
         let aabb = shape.aabb(&pose);
         let handle: ObjectHandle = self.broadphase.create_proxy(aabb, filter)?.into();
         let i = handle.index as usize;
@@ -210,7 +217,23 @@ impl CollisionWorld {
             added: conv(&ch.added),
             removed: conv(&ch.removed),
         };
+        let objects = &self.objects;
+        let (added, removed) = (&self.changes.added, &self.changes.removed);
+        self.narrowphase.step(added, removed, |h: ObjectHandle| {
+            let o = objects.get(h.index as usize)?.as_ref()?;
+            (o.handle == h).then_some((&*o.shape, o.pose))
+        })?;
         Ok(&self.changes)
+    }
+
+    /// The narrowphase: manifolds and contact events of the last update.
+    pub fn narrowphase(&self) -> &NarrowPhase<ObjectHandle> {
+        &self.narrowphase
+    }
+
+    /// The narrowphase, to configure the dispatcher, mark sensors or store impulses.
+    pub fn narrowphase_mut(&mut self) -> &mut NarrowPhase<ObjectHandle> {
+        &mut self.narrowphase
     }
 
     /// The current broadphase pairs (as of the last update), sorted.

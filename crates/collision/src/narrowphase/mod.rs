@@ -18,3 +18,5 @@ pub mod mesh;
 pub mod polyhedron;
 
 pub use dispatcher::{Dispatcher, Generated, UserAlgorithm};
+pub mod pipeline;
+pub use pipeline::{ContactEvent, ContactEventKind, NarrowPhase, PairContact};
