@@ -188,8 +188,18 @@ impl ContactManifold {
             }
             best
         };
-        let i1 = argmax(&|i| (q[i] - q[i0]).length_squared());
-        let i2 = argmax(&|i| (q[i1] - q[i0]).cross(q[i] - q[i0]).dot(n).abs());
+        let i1 = argmax(&|i| {
+            if i == i0 {
+                return Real::NEG_INFINITY;
+            }
+            (q[i] - q[i0]).length_squared()
+        });
+        let i2 = argmax(&|i| {
+            if i == i0 || i == i1 {
+                return Real::NEG_INFINITY;
+            }
+            (q[i1] - q[i0]).cross(q[i] - q[i0]).dot(n).abs()
+        });
         let (i1, i2) = if (q[i1] - q[i0]).cross(q[i2] - q[i0]).dot(n) < 0.0 {
             (i2, i1)
         } else {
@@ -198,6 +208,9 @@ impl ContactManifold {
         // The point most outside the triangle (i0, i1, i2): most negative signed area
         // against one of its edges.
         let i3 = argmax(&|i| {
+            if i == i0 || i == i1 || i == i2 {
+                return Real::NEG_INFINITY;
+            }
             let e = [(i0, i1), (i1, i2), (i2, i0)];
             e.iter()
                 .map(|&(u, v)| -(q[v] - q[u]).cross(q[i] - q[u]).dot(n))

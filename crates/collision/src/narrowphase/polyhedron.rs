@@ -147,6 +147,8 @@ fn is_minkowski_face(a: Vec3, b: Vec3, c: Vec3, d: Vec3) -> bool {
 fn edge_query(a: &Polyhedron, b: &Polyhedron, pose_ab: &Isometry) -> (Real, usize, usize, Vec3) {
     let mut best = (Real::NEG_INFINITY, 0, 0, Vec3::ZERO);
     let ident = Isometry::IDENTITY;
+    let a_centre =
+        a.vertices.iter().fold(Vec3::ZERO, |s, v| s + *v) / a.vertices.len().max(1) as Real;
     for (i, ea) in a.edges.iter().enumerate() {
         let (pa, qa) = (a.vertices[ea[0] as usize], a.vertices[ea[1] as usize]);
         let (na0, na1) = (a.faces[ea[2] as usize].0, a.faces[ea[3] as usize].0);
@@ -164,10 +166,25 @@ fn edge_query(a: &Polyhedron, b: &Polyhedron, pose_ab: &Isometry) -> (Real, usiz
                 continue;
             }
             let axis = axis / len;
-            // Exact separation along ±axis (both orientations, keep the larger).
-            let s1 = -b.support_dot(pose_ab, -axis) - a.support_dot(&ident, axis);
-            let s2 = -b.support_dot(pose_ab, axis) - a.support_dot(&ident, -axis);
-            let (s, ax) = if s1 >= s2 { (s1, axis) } else { (s2, -axis) };
+            let (s, ax) = if a.flat || b.flat {
+                // Flat polygons: exact separation along ±axis, keep the larger.
+                let s1 = -b.support_dot(pose_ab, -axis) - a.support_dot(&ident, axis);
+                let s2 = -b.support_dot(pose_ab, axis) - a.support_dot(&ident, -axis);
+                if s1 >= s2 {
+                    (s1, axis)
+                } else {
+                    (s2, -axis)
+                }
+            } else {
+                // Gregorius: orient the axis away from A's centre; the edges are the
+                // supporting features of a Minkowski face, so the distance is along them.
+                let ax = if axis.dot(pa - a_centre) < 0.0 {
+                    -axis
+                } else {
+                    axis
+                };
+                (ax.dot(pb - pa), ax)
+            };
             if s > best.0 {
                 best = (s, i, j, ax);
             }
@@ -238,6 +255,19 @@ fn clip_faces(
         std::mem::swap(&mut poly, &mut tmp);
         if poly.is_empty() {
             break;
+        }
+    }
+    if poly.is_empty() {
+        // Deep or lateral configurations where the incident face misses the reference
+        // face's prism: fall back to the deepest vertex of the incident shape.
+        let k = (0..inc.vertices.len())
+            .min_by(|&i, &j| {
+                let (pi, pj) = (inc.vertices[i].dot(n_in_inc), inc.vertices[j].dot(n_in_inc));
+                pi.partial_cmp(&pj).unwrap_or(std::cmp::Ordering::Equal)
+            })
+            .unwrap_or(0);
+        if let Some(v) = inc.vertices.get(k) {
+            poly.push((pose_ri.transform_point(*v), id | 0xFEFF));
         }
     }
     poly.into_iter()
