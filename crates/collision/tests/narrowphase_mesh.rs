@@ -166,3 +166,69 @@ fn extreme_poses_never_produce_nan() {
         }
     }
 }
+
+#[test]
+fn box_on_flat_mesh_gets_four_points_at_the_right_depth() {
+    let d = Dispatcher::default();
+    let mesh = Shape::TriMesh(grid(4));
+    let b = Shape::Cuboid(Cuboid::new(Vec3::splat(0.5)).unwrap());
+    let pose = Isometry::new(Vec3::new(0.2, 0.5 - 0.01, 0.1), Quat::from_rotation_y(0.5));
+    let mut m = ContactManifold::new();
+    d.update_manifold(&mesh, &Isometry::IDENTITY, &b, &pose, &mut m)
+        .unwrap();
+    assert_eq!(m.len(), 4);
+    // Oracle: the bottom corners of the box.
+    let corners: Vec<Vec3> = [(-1.0, -1.0), (-1.0, 1.0), (1.0, -1.0), (1.0, 1.0)]
+        .iter()
+        .map(|&(x, z)| pose.transform_point(Vec3::new(0.5 * x, -0.5, 0.5 * z)))
+        .collect();
+    for p in &m.points {
+        assert!((p.distance + 0.01).abs() < 1e-4);
+        assert!(
+            corners.iter().any(|c| (*c - p.point_b).length() < 1e-3),
+            "{:?}",
+            p.point_b
+        );
+    }
+}
+
+#[test]
+fn compound_children_merge_into_one_reduced_manifold() {
+    use carom_collision::shape::Compound;
+    let child = Arc::new(Shape::Cuboid(Cuboid::new(Vec3::splat(0.5)).unwrap()));
+    let comp = Shape::Compound(
+        Compound::new(vec![
+            (
+                Isometry::from_translation(Vec3::new(-1.0, 0.0, 0.0)),
+                child.clone(),
+            ),
+            (Isometry::from_translation(Vec3::new(1.0, 0.0, 0.0)), child),
+        ])
+        .unwrap(),
+    );
+    let ground = Shape::Plane(Plane::new(Vec3::Y, 0.0).unwrap());
+    let d = Dispatcher::default();
+    let pose = Isometry::from_translation(Vec3::new(0.0, 0.49, 0.0));
+    for (a, pa, b, pb) in [
+        (&comp, pose, &ground, Isometry::IDENTITY),
+        (&ground, Isometry::IDENTITY, &comp, pose),
+    ] {
+        let mut m = ContactManifold::new();
+        d.update_manifold(a, &pa, b, &pb, &mut m).unwrap();
+        assert_eq!(m.len(), 4);
+        let mut xs: Vec<Real> = m
+            .points
+            .iter()
+            .map(|p| p.point_b.x.min(p.point_a().x))
+            .collect();
+        xs.sort_by(|a, b| a.partial_cmp(b).unwrap());
+        // Reduction keeps the outer corners: the widest footprint, x = ±1.5.
+        assert!(
+            (xs[0] + 1.5).abs() < 1e-3 && (xs[3] - 1.5).abs() < 1e-3,
+            "{xs:?}"
+        );
+        for p in &m.points {
+            assert!((p.distance + 0.01).abs() < 1e-4);
+        }
+    }
+}

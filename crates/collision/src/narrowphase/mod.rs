@@ -2,8 +2,9 @@
 //! persistent multi-point contact manifolds.
 //!
 //! - [`contact`]: the contact point; [`manifold`]: the persistent manifold;
-//! - [`polyhedron`] and [`box_box`]: SAT with Gauss-map pruning and face clipping for
-//!   boxes, hulls and triangles; [`convex`]: analytic manifolds for round shapes and
+//! - [`pipeline`]: the [`NarrowPhase`] stage of the collision world (events, sensors);
+//! - [`polyhedron`]: SAT with Gauss-map pruning and face clipping for boxes (box–box
+//!   clipping), hulls and triangles, and plane–polyhedron; [`convex`]: analytic manifolds for round shapes and
 //!   multi-point by perturbation; [`mesh`]: convex against triangle meshes and compounds
 //!   with internal-edge correction; [`dispatcher`]: the shape-pair table.
 
