@@ -232,3 +232,36 @@ fn compound_children_merge_into_one_reduced_manifold() {
         }
     }
 }
+
+#[test]
+fn cylinder_standing_on_a_mesh_gets_three_points_by_caching() {
+    let d = Dispatcher::default();
+    let mesh = Shape::TriMesh(grid(4));
+    let cyl = Shape::Cylinder(Cylinder::new(0.5, 0.5).unwrap());
+    let pose = Isometry::from_translation(Vec3::new(0.3, 0.5 - 0.002, 0.2));
+    let mut m = ContactManifold::new();
+    for _ in 0..3 {
+        d.update_manifold(&mesh, &Isometry::IDENTITY, &cyl, &pose, &mut m)
+            .unwrap();
+    }
+    assert!(m.len() >= 3, "{} points", m.len());
+    for p in &m.points {
+        // Oracle: points on the bottom disc, 0.002 below the mesh plane y = 0.
+        let r = Vec3::new(p.point_b.x - 0.3, 0.0, p.point_b.z - 0.2).length();
+        assert!(r < 0.5 + 2e-3, "radius {r}");
+        assert!((p.point_b.y + 0.002).abs() < 2e-3, "{:?}", p.point_b);
+        assert!((p.distance + 0.002).abs() < 2e-3, "distance {}", p.distance);
+        assert!((-p.normal).dot(Vec3::Y) > 0.9998);
+    }
+    // A stable support: the points span a triangle of real area.
+    let q: Vec<Vec3> = m.points.iter().map(|p| p.point_b).collect();
+    let mut best: Real = 0.0;
+    for i in 0..q.len() {
+        for j in i + 1..q.len() {
+            for k in j + 1..q.len() {
+                best = best.max(0.5 * (q[j] - q[i]).cross(q[k] - q[i]).length());
+            }
+        }
+    }
+    assert!(best > 0.01, "footprint area {best}");
+}

@@ -105,6 +105,13 @@ pub fn convex_convex(
         ),
         _ => match (as_polyhedron(a), as_polyhedron(b)) {
             (Some(pa), Some(pb)) => full(polyhedron_manifold(&pa, &pb, pose_ab, pred)),
+            _ if matches!(a, C::Triangle(_)) => {
+                // Perturb the shape, not the triangle (whose origin is the mesh's).
+                swap(
+                    convex_convex(b, a, &pose_ab.inverse(), cfg, want_full),
+                    pose_ab,
+                )
+            }
             _ => {
                 let f = |p: &Isometry| contact_convex(a, b, p, pred);
                 let Some(c0) = f(pose_ab) else {
@@ -248,12 +255,17 @@ pub fn generate(
         )),
         (Shape::TriMesh(m), _) if b.is_convex() => {
             let cb = b.as_convex().expect("checked");
+            // Shapes without one-shot manifolds (cylinders, cones, scaled shapes) use the
+            // hybrid method: perturbation when the cache is empty, single points after.
+            let incremental = as_polyhedron(cb).is_none()
+                && !matches!(cb, ConvexRef::Sphere(_) | ConvexRef::Capsule(_));
             let tri_contacts = |t: &crate::shape::Triangle| {
-                convex_convex(ConvexRef::Triangle(t), cb, pose_ab, cfg, false).contacts
+                let full = want_full && incremental;
+                convex_convex(ConvexRef::Triangle(t), cb, pose_ab, cfg, full).contacts
             };
             Ok(Generated {
                 contacts: mesh_convex_contacts(m, cb, pose_ab, cfg.prediction, &tri_contacts),
-                full: true,
+                full: !incremental,
             })
         }
         (_, Shape::Plane(_) | Shape::TriMesh(_)) if a.is_convex() => {
