@@ -12,10 +12,13 @@
 #![warn(missing_docs)]
 #![deny(unsafe_code)]
 
+pub mod broadphase;
 pub mod error;
 pub mod math;
 pub mod midphase;
+pub mod narrowphase;
 pub mod query;
 pub mod shape;
+pub mod world;
 
 pub use error::{CaromError, Result};

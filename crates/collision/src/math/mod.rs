@@ -6,10 +6,12 @@
 
 mod aabb;
 mod isometry;
+mod order_key;
 mod validate;
 
 pub use aabb::Aabb;
 pub use isometry::Isometry;
+pub use order_key::{f32_to_ordered, ordered_to_real, real_ceil_key, real_floor_key};
 pub use validate::*;
 
 #[cfg(not(feature = "f64"))]

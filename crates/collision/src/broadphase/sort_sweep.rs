@@ -1,0 +1,180 @@
+//! One-axis sort-and-sweep from scratch, in parallel: the talk's "parallel 1 axis sweep and
+//! prune" (OPCODE's complete box pruning, Terdiman 2002; Game Physics Pearls ch. 7; Le Grand,
+//! GPU Gems 3 ch. 32).
+//!
+//! Each update: pick the axis along which the box centres vary most (fewest boxes overlap on
+//! it), radix-sort the boxes by their min on that axis ([`super::radix::par_sort_u64`]), then
+//! for each box scan forward while the next min does not exceed its max, testing the two other
+//! axes. The scan is split into fixed-size chunks run in parallel (rayon); chunk boundaries do
+//! not depend on the thread count and the pairs are sorted afterwards, so the result is the
+//! same on any number of threads. Nothing is kept between updates: cost does not depend on
+//! how far objects moved.
+
+use super::radix::par_sort_u64;
+use super::{impl_common_broadphase, pair_key, BroadPhase, Filter, PairCache, PairChanges};
+use super::{ProxyHandle, ProxyStore};
+use crate::error::Result;
+use crate::math::{ordered_to_real, real_floor_key, Aabb, Real, Vec3};
+
+/// Boxes swept per parallel task.
+const SWEEP_CHUNK: usize = 1024;
+
+/// The from-scratch sort-and-sweep broadphase (see the module docs).
+#[derive(Debug, Clone, Default)]
+pub struct SortSweep {
+    store: ProxyStore,
+    cache: PairCache,
+    /// Axis used by the last update (0, 1 or 2).
+    last_axis: usize,
+}
+
+impl SortSweep {
+    /// An empty broadphase.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// The axis the last update swept along.
+    pub fn last_axis(&self) -> usize {
+        self.last_axis
+    }
+}
+
+/// The axis of greatest variance of the centres of `boxes` (sums in a fixed order).
+pub fn axis_of_greatest_variance(boxes: &[Aabb], ids: &[u32]) -> usize {
+    if ids.is_empty() {
+        return 0;
+    }
+    let n = ids.len() as Real;
+    let mut sum = Vec3::ZERO;
+    let mut sum_sq = Vec3::ZERO;
+    for &i in ids {
+        let c = boxes[i as usize].center();
+        sum += c;
+        sum_sq += c * c;
+    }
+    let var = sum_sq / n - (sum / n) * (sum / n);
+    if var.x >= var.y && var.x >= var.z {
+        0
+    } else if var.y >= var.z {
+        1
+    } else {
+        2
+    }
+}
+
+/// Sorted sweep data: boxes in sweep order, their rounded-down min on the axis, their ids.
+struct Sorted {
+    boxes: Vec<Aabb>,
+    lo: Vec<Real>,
+    ids: Vec<u32>,
+}
+
+/// Sweeps the sorted boxes with indices in `range`, pushing pair keys to `out`.
+fn sweep_range(s: &Sorted, axis: usize, range: std::ops::Range<usize>, out: &mut Vec<u64>) {
+    let (j_ax, k_ax) = ((axis + 1) % 3, (axis + 2) % 3);
+    let n = s.boxes.len();
+    for i in range {
+        let bi = &s.boxes[i];
+        let hi = bi.max[axis];
+        let mut j = i + 1;
+        while j < n && s.lo[j] <= hi {
+            let bj = &s.boxes[j];
+            if bi.min[j_ax] <= bj.max[j_ax]
+                && bj.min[j_ax] <= bi.max[j_ax]
+                && bi.min[k_ax] <= bj.max[k_ax]
+                && bj.min[k_ax] <= bi.max[k_ax]
+                && bi.min[axis] <= bj.max[axis]
+                && bj.min[axis] <= bi.max[axis]
+            {
+                out.push(pair_key(s.ids[i], s.ids[j]));
+            }
+            j += 1;
+        }
+    }
+}
+
+/// All overlapping pairs among `boxes[ids]` as unsorted pair keys (each pair once).
+pub fn find_pairs(boxes: &[Aabb], ids: &[u32]) -> (Vec<u64>, usize) {
+    let axis = axis_of_greatest_variance(boxes, ids);
+    let mut keys: Vec<u64> = ids
+        .iter()
+        .map(|&i| ((real_floor_key(boxes[i as usize].min[axis]) as u64) << 32) | i as u64)
+        .collect();
+    par_sort_u64(&mut keys);
+    let mut s = Sorted {
+        boxes: Vec::with_capacity(keys.len()),
+        lo: Vec::with_capacity(keys.len()),
+        ids: Vec::with_capacity(keys.len()),
+    };
+    for &k in &keys {
+        let id = k as u32;
+        s.boxes.push(boxes[id as usize]);
+        s.ids.push(id);
+        s.lo.push(ordered_to_real((k >> 32) as u32));
+    }
+    let n = s.boxes.len();
+    let chunks = n.div_ceil(SWEEP_CHUNK);
+    #[cfg(feature = "parallel")]
+    let parts: Vec<Vec<u64>> = {
+        use rayon::prelude::*;
+        (0..chunks)
+            .into_par_iter()
+            .map(|c| {
+                let mut out = Vec::new();
+                sweep_range(
+                    &s,
+                    axis,
+                    c * SWEEP_CHUNK..((c + 1) * SWEEP_CHUNK).min(n),
+                    &mut out,
+                );
+                out
+            })
+            .collect()
+    };
+    #[cfg(not(feature = "parallel"))]
+    let parts: Vec<Vec<u64>> = (0..chunks)
+        .map(|c| {
+            let mut out = Vec::new();
+            sweep_range(
+                &s,
+                axis,
+                c * SWEEP_CHUNK..((c + 1) * SWEEP_CHUNK).min(n),
+                &mut out,
+            );
+            out
+        })
+        .collect();
+    (parts.concat(), axis)
+}
+
+impl BroadPhase for SortSweep {
+    fn name(&self) -> &'static str {
+        "sort_sweep"
+    }
+
+    fn create_proxy(&mut self, aabb: Aabb, filter: Filter) -> Result<ProxyHandle> {
+        self.store.create(aabb, filter)
+    }
+
+    fn update_proxy(&mut self, proxy: ProxyHandle, aabb: Aabb, _displacement: Vec3) -> Result<()> {
+        self.store.set_aabb(proxy, aabb).map(|_| ())
+    }
+
+    fn remove_proxy(&mut self, proxy: ProxyHandle) -> Result<()> {
+        self.store.remove(proxy).map(|_| ())
+    }
+
+    fn set_resting(&mut self, proxy: ProxyHandle, _resting: bool) -> Result<()> {
+        self.store.check(proxy).map(|_| ())
+    }
+
+    fn update_pairs(&mut self) -> &PairChanges {
+        let live = self.store.live_indices();
+        let (keys, axis) = find_pairs(self.store.aabbs(), &live);
+        self.last_axis = axis;
+        self.cache.replace(&mut self.store, keys, false)
+    }
+
+    impl_common_broadphase!();
+}

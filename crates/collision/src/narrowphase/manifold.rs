@@ -1,0 +1,224 @@
+//! The persistent contact manifold: Bullet's `btPersistentManifold` (Coumans, "Contact
+//! Generation", GDC 2010, "Persistent contact caching"), with points stored in each body's
+//! local frame, refreshed from the current poses, matched by feature id or distance so that
+//! accumulated impulses survive, and reduced to four points (deepest kept, area maximised,
+//! as in Box3D's and Jolt's manifold reduction).
+
+use super::contact::{ContactPoint, NO_FEATURE};
+use crate::math::{Isometry, Real, Vec3};
+use serde::{Deserialize, Serialize};
+
+/// Maximum number of points a manifold keeps after reduction.
+pub const MAX_MANIFOLD_POINTS: usize = 4;
+
+/// Tuning of contact generation and caching, in length units.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct ManifoldConfig {
+    /// Speculative margin: points are generated while the shapes are at most this far apart.
+    pub prediction: Real,
+    /// A cached point is dropped when its distance grows beyond this (Bullet's contact
+    /// breaking threshold) or when its two witness points drift tangentially further apart.
+    pub breaking_threshold: Real,
+    /// A new point closer than this to a cached one (on B) replaces it.
+    pub merge_distance: Real,
+    /// Perturbation angle (radians) for multi-point generation on general convex shapes;
+    /// clamped to a small value per the talk.
+    pub perturbation_angle: Real,
+    /// Number of perturbed queries (0 disables perturbation).
+    pub perturbation_iterations: u32,
+}
+
+impl Default for ManifoldConfig {
+    fn default() -> Self {
+        ManifoldConfig {
+            prediction: 0.02,
+            breaking_threshold: 0.02,
+            merge_distance: 0.02,
+            perturbation_angle: 0.05,
+            perturbation_iterations: 4,
+        }
+    }
+}
+
+/// Up to [`MAX_MANIFOLD_POINTS`] contact points between bodies A and B (see [`ContactPoint`]
+/// for the conventions).
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct ContactManifold {
+    /// The points, in insertion order (stable across steps while they persist).
+    pub points: Vec<ContactPoint>,
+}
+
+impl ContactManifold {
+    /// An empty manifold.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Number of points.
+    pub fn len(&self) -> usize {
+        self.points.len()
+    }
+
+    /// True when there is no point.
+    pub fn is_empty(&self) -> bool {
+        self.points.is_empty()
+    }
+
+    /// Removes every point.
+    pub fn clear(&mut self) {
+        self.points.clear();
+    }
+
+    /// The deepest (smallest) distance, or `None` when empty.
+    pub fn min_distance(&self) -> Option<Real> {
+        self.points.iter().map(|p| p.distance).reduce(Real::min)
+    }
+
+    /// Recomputes every point's world data and distance from the bodies' current poses
+    /// (`distance = (a - b) · n`, the talk's "update contact distance") and drops the points
+    /// whose distance exceeds `breaking_threshold` or whose witness points drifted
+    /// tangentially by more than `breaking_threshold`.
+    pub fn refresh(&mut self, pose_a: &Isometry, pose_b: &Isometry, breaking_threshold: Real) {
+        self.points.retain_mut(|p| {
+            let a = pose_a.transform_point(p.local_a);
+            let b = pose_b.transform_point(p.local_b);
+            let n = pose_b.transform_vector(p.local_normal_b);
+            let d = (a - b).dot(n);
+            if d.is_nan() || d > breaking_threshold {
+                return false;
+            }
+            let drift = (a - n * d) - b;
+            if drift.length_squared() > breaking_threshold * breaking_threshold {
+                return false;
+            }
+            p.distance = d;
+            p.normal = n;
+            p.point_b = b;
+            p.lifetime = p.lifetime.saturating_add(1);
+            true
+        });
+    }
+
+    /// The index of the cached point the new point `p` duplicates: the same feature id, or
+    /// else the closest point on B within `merge_distance` (without a feature match).
+    pub fn find_match(&self, p: &ContactPoint, merge_distance: Real) -> Option<usize> {
+        if p.feature != NO_FEATURE {
+            if let Some(i) = self.points.iter().position(|q| q.feature == p.feature) {
+                return Some(i);
+            }
+        }
+        let mut best = None;
+        let mut best_d2 = merge_distance * merge_distance;
+        for (i, q) in self.points.iter().enumerate() {
+            let d2 = (q.local_b - p.local_b).length_squared();
+            if d2 <= best_d2 {
+                best_d2 = d2;
+                best = Some(i);
+            }
+        }
+        best
+    }
+
+    /// Adds one point (the incremental half of the hybrid method): a duplicate replaces the
+    /// cached point and inherits its impulses and lifetime; beyond four points the manifold
+    /// is reduced. Non-finite points are ignored.
+    pub fn add_point(&mut self, mut p: ContactPoint, merge_distance: Real) {
+        if !p.is_finite() {
+            return;
+        }
+        if let Some(i) = self.find_match(&p, merge_distance) {
+            let old = &self.points[i];
+            p.normal_impulse = old.normal_impulse;
+            p.tangent_impulse = old.tangent_impulse;
+            p.lifetime = old.lifetime;
+            self.points[i] = p;
+            return;
+        }
+        self.points.push(p);
+        if self.points.len() > MAX_MANIFOLD_POINTS {
+            self.reduce();
+        }
+    }
+
+    /// Replaces the whole manifold by a freshly generated full one (the one-shot half of the
+    /// hybrid method), carrying impulses and lifetimes over from matching cached points.
+    pub fn replace_all(&mut self, mut new_points: Vec<ContactPoint>, merge_distance: Real) {
+        new_points.retain(|p| p.is_finite());
+        for p in new_points.iter_mut() {
+            if let Some(i) = self.find_match(p, merge_distance) {
+                let old = &self.points[i];
+                p.normal_impulse = old.normal_impulse;
+                p.tangent_impulse = old.tangent_impulse;
+                p.lifetime = old.lifetime;
+            }
+        }
+        self.points = new_points;
+        if self.points.len() > MAX_MANIFOLD_POINTS {
+            self.reduce();
+        }
+    }
+
+    /// Reduces to at most four points: keeps the deepest, then the point farthest from it,
+    /// then the one making the largest triangle with those two, then the one adding the most
+    /// area outside that triangle (all measured in the plane orthogonal to the deepest
+    /// point's normal). Ties keep the earliest point, so the result is deterministic.
+    pub fn reduce(&mut self) {
+        let pts = &self.points;
+        if pts.len() <= MAX_MANIFOLD_POINTS {
+            return;
+        }
+        let mut i0 = 0;
+        for (i, p) in pts.iter().enumerate() {
+            if p.distance < pts[i0].distance {
+                i0 = i;
+            }
+        }
+        let n = pts[i0].normal;
+        let proj = |v: Vec3| v - n * v.dot(n);
+        let q: Vec<Vec3> = pts.iter().map(|p| proj(p.point_b)).collect();
+        let argmax = |f: &dyn Fn(usize) -> Real| -> usize {
+            let mut best = 0;
+            let mut best_v = Real::NEG_INFINITY;
+            for i in 0..q.len() {
+                let v = f(i);
+                if v > best_v {
+                    best_v = v;
+                    best = i;
+                }
+            }
+            best
+        };
+        let i1 = argmax(&|i| {
+            if i == i0 {
+                return Real::NEG_INFINITY;
+            }
+            (q[i] - q[i0]).length_squared()
+        });
+        let i2 = argmax(&|i| {
+            if i == i0 || i == i1 {
+                return Real::NEG_INFINITY;
+            }
+            (q[i1] - q[i0]).cross(q[i] - q[i0]).dot(n).abs()
+        });
+        let (i1, i2) = if (q[i1] - q[i0]).cross(q[i2] - q[i0]).dot(n) < 0.0 {
+            (i2, i1)
+        } else {
+            (i1, i2)
+        };
+        // The point most outside the triangle (i0, i1, i2): most negative signed area
+        // against one of its edges.
+        let i3 = argmax(&|i| {
+            if i == i0 || i == i1 || i == i2 {
+                return Real::NEG_INFINITY;
+            }
+            let e = [(i0, i1), (i1, i2), (i2, i0)];
+            e.iter()
+                .map(|&(u, v)| -(q[v] - q[u]).cross(q[i] - q[u]).dot(n))
+                .fold(Real::NEG_INFINITY, Real::max)
+        });
+        let mut keep = vec![i0, i1, i2, i3];
+        keep.sort_unstable();
+        keep.dedup();
+        self.points = keep.into_iter().map(|i| pts[i]).collect();
+    }
+}

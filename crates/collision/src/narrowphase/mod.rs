@@ -1,0 +1,23 @@
+//! Contact generation (Coumans, "Contact Generation", GDC 2010): turns overlapping pairs into
+//! persistent multi-point contact manifolds.
+//!
+//! - [`contact`]: the contact point; [`manifold`]: the persistent manifold;
+//! - [`pipeline`]: the [`NarrowPhase`] stage of the collision world (events, sensors);
+//! - [`polyhedron`]: SAT with Gauss-map pruning and face clipping for boxes (box–box
+//!   clipping), hulls and triangles, and plane–polyhedron; [`convex`]: analytic manifolds for round shapes and
+//!   multi-point by perturbation; [`mesh`]: convex against triangle meshes and compounds
+//!   with internal-edge correction; [`dispatcher`]: the shape-pair table.
+
+pub mod contact;
+pub mod manifold;
+
+pub use contact::{ContactPoint, FeatureId, NO_FEATURE};
+pub use manifold::{ContactManifold, ManifoldConfig, MAX_MANIFOLD_POINTS};
+pub mod convex;
+pub mod dispatcher;
+pub mod mesh;
+pub mod polyhedron;
+
+pub use dispatcher::{Dispatcher, Generated, UserAlgorithm};
+pub mod pipeline;
+pub use pipeline::{ContactEvent, ContactEventKind, NarrowPhase, PairContact};

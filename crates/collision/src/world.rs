@@ -1,0 +1,252 @@
+//! The collision world: shapes with poses and filters, a broadphase, and the
+//! narrowphase. Objects are named by generational handles; [`CollisionWorld::update`]
+//! recomputes the boxes of the objects that moved (`Shape::aabb(pose)`) and reports the
+//! broadphase pairs added and removed, in a deterministic order.
+//!
+//! The broadphase is an [`AnyBroadPhase`] (an enum over every method, no `dyn`), chosen with
+//! [`Method`].
+
+use crate::broadphase::{AnyBroadPhase, BroadPhase, Filter, Method, ProxyHandle, UserFilter};
+use crate::error::{CaromError, Result};
+use crate::math::{check_isometry, Aabb, Isometry, Vec3};
+use crate::narrowphase::NarrowPhase;
+use crate::shape::Shape;
+use std::sync::Arc;
+
+/// A handle to an object of a [`CollisionWorld`]: its slot and the slot's generation
+/// (the broadphase proxy handle of the object).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub struct ObjectHandle {
+    /// Slot index.
+    pub index: u32,
+    /// Generation of the slot.
+    pub generation: u32,
+}
+
+impl From<ProxyHandle> for ObjectHandle {
+    fn from(p: ProxyHandle) -> Self {
+        ObjectHandle {
+            index: p.index,
+            generation: p.generation,
+        }
+    }
+}
+
+impl ObjectHandle {
+    fn proxy(self) -> ProxyHandle {
+        ProxyHandle {
+            index: self.index,
+            generation: self.generation,
+        }
+    }
+}
+
+/// One object: a shared shape at a pose, with a collision filter.
+#[derive(Debug, Clone)]
+pub struct CollisionObject {
+    /// The shape (shared, immutable).
+    pub shape: Arc<Shape>,
+    /// World pose.
+    pub pose: Isometry,
+    /// Collision filter.
+    pub filter: Filter,
+    /// World box at the last update.
+    pub aabb: Aabb,
+    handle: ObjectHandle,
+    dirty: bool,
+    displacement: Vec3,
+}
+
+/// Pairs of objects that started or stopped overlapping (broadphase boxes) at an update.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct WorldPairChanges {
+    /// New pairs, sorted by (lower index, higher index).
+    pub added: Vec<(ObjectHandle, ObjectHandle)>,
+    /// Pairs that ended (or whose object was removed), sorted the same way.
+    pub removed: Vec<(ObjectHandle, ObjectHandle)>,
+}
+
+/// Objects plus a broadphase (see the module docs).
+#[derive(Debug, Clone, Default)]
+pub struct CollisionWorld {
+    objects: Vec<Option<CollisionObject>>,
+    broadphase: AnyBroadPhase,
+    dirty: Vec<u32>,
+    changes: WorldPairChanges,
+    narrowphase: NarrowPhase<ObjectHandle>,
+}
+
+impl CollisionWorld {
+    /// An empty world using the broadphase `method`.
+    pub fn new(method: Method) -> Self {
+        CollisionWorld {
+            broadphase: AnyBroadPhase::new(method),
+            ..Default::default()
+        }
+    }
+
+    /// The broadphase.
+    pub fn broadphase(&self) -> &AnyBroadPhase {
+        &self.broadphase
+    }
+
+    /// Installs or clears a user pair filter (called with the two objects' handles).
+    pub fn set_user_filter(
+        &mut self,
+        filter: Option<Arc<dyn Fn(ObjectHandle, ObjectHandle) -> bool + Send + Sync>>,
+    ) {
+        let f: Option<UserFilter> = filter.map(|f| {
+            Arc::new(move |a: ProxyHandle, b: ProxyHandle| f(a.into(), b.into())) as UserFilter
+        });
+        self.broadphase.set_user_filter(f);
+    }
+
+    /// Adds an object; its box is computed now. A non-finite pose or a shape whose box is
+    /// not finite is an error.
+    pub fn add(
+        &mut self,
+        shape: Arc<Shape>,
+        pose: Isometry,
+        filter: Filter,
+    ) -> Result<ObjectHandle> {
+        let pose = check_isometry("pose", pose)?;
+        if !shape.is_convex() {
+            for o in self.objects.iter().flatten() {
+                self.narrowphase.dispatcher.check_pair(&shape, &o.shape)?;
+            }
+        }
+        let aabb = shape.aabb(&pose);
+        let handle: ObjectHandle = self.broadphase.create_proxy(aabb, filter)?.into();
+        let i = handle.index as usize;
+        if i >= self.objects.len() {
+            self.objects.resize(i + 1, None);
+        }
+        self.objects[i] = Some(CollisionObject {
+            shape,
+            pose,
+            filter,
+            aabb,
+            handle,
+            dirty: false,
+            displacement: Vec3::ZERO,
+        });
+        Ok(handle)
+    }
+
+    fn slot(&self, h: ObjectHandle) -> Result<usize> {
+        match self.objects.get(h.index as usize) {
+            Some(Some(o)) if o.handle == h => Ok(h.index as usize),
+            _ => Err(CaromError::UnknownHandle(format!("{h:?}"))),
+        }
+    }
+
+    /// The object named by `h`.
+    pub fn get(&self, h: ObjectHandle) -> Result<&CollisionObject> {
+        let i = self.slot(h)?;
+        Ok(self.objects[i].as_ref().expect("slot checked"))
+    }
+
+    /// Moves an object; its box is recomputed at the next [`CollisionWorld::update`].
+    pub fn set_pose(&mut self, h: ObjectHandle, pose: Isometry) -> Result<()> {
+        let i = self.slot(h)?;
+        let pose = check_isometry("pose", pose)?;
+        let o = self.objects[i].as_mut().expect("slot checked");
+        o.displacement = pose.translation - o.pose.translation;
+        o.pose = pose;
+        if !o.dirty {
+            o.dirty = true;
+            self.dirty.push(i as u32);
+        }
+        Ok(())
+    }
+
+    /// Changes an object's filter.
+    pub fn set_filter(&mut self, h: ObjectHandle, filter: Filter) -> Result<()> {
+        let i = self.slot(h)?;
+        self.broadphase.set_filter(h.proxy(), filter)?;
+        self.objects[i].as_mut().expect("slot checked").filter = filter;
+        Ok(())
+    }
+
+    /// Hints that an object is resting (sleeping) or moving again.
+    pub fn set_resting(&mut self, h: ObjectHandle, resting: bool) -> Result<()> {
+        self.slot(h)?;
+        self.broadphase.set_resting(h.proxy(), resting)
+    }
+
+    /// Removes an object; its pairs are reported as removed by the next update.
+    pub fn remove(&mut self, h: ObjectHandle) -> Result<CollisionObject> {
+        let i = self.slot(h)?;
+        self.broadphase.remove_proxy(h.proxy())?;
+        Ok(self.objects[i].take().expect("slot checked"))
+    }
+
+    /// Number of objects.
+    pub fn len(&self) -> usize {
+        self.broadphase.len()
+    }
+
+    /// True when there is no object.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Recomputes the boxes of moved objects and updates the broadphase pairs.
+    pub fn update(&mut self) -> Result<&WorldPairChanges> {
+        let mut dirty = std::mem::take(&mut self.dirty);
+        dirty.sort_unstable();
+        for &i in &dirty {
+            let Some(o) = self.objects[i as usize].as_mut() else {
+                continue;
+            };
+            if !o.dirty {
+                continue;
+            }
+            o.dirty = false;
+            o.aabb = o.shape.aabb(&o.pose);
+            self.broadphase
+                .update_proxy(o.handle.proxy(), o.aabb, o.displacement)?;
+        }
+        dirty.clear();
+        self.dirty = dirty;
+        let ch = self.broadphase.update_pairs();
+        let conv = |v: &[(ProxyHandle, ProxyHandle)]| -> Vec<(ObjectHandle, ObjectHandle)> {
+            v.iter().map(|&(a, b)| (a.into(), b.into())).collect()
+        };
+        self.changes = WorldPairChanges {
+            added: conv(&ch.added),
+            removed: conv(&ch.removed),
+        };
+        let objects = &self.objects;
+        let (added, removed) = (&self.changes.added, &self.changes.removed);
+        self.narrowphase.step(added, removed, |h: ObjectHandle| {
+            let o = objects.get(h.index as usize)?.as_ref()?;
+            (o.handle == h).then_some((&*o.shape, o.pose))
+        })?;
+        Ok(&self.changes)
+    }
+
+    /// The narrowphase: manifolds and contact events of the last update.
+    pub fn narrowphase(&self) -> &NarrowPhase<ObjectHandle> {
+        &self.narrowphase
+    }
+
+    /// The narrowphase, to configure the dispatcher, mark sensors or store impulses.
+    pub fn narrowphase_mut(&mut self) -> &mut NarrowPhase<ObjectHandle> {
+        &mut self.narrowphase
+    }
+
+    /// The current broadphase pairs (as of the last update), sorted.
+    pub fn pairs(&self) -> Vec<(ObjectHandle, ObjectHandle)> {
+        self.broadphase
+            .pairs()
+            .into_iter()
+            .map(|(a, b)| (a.into(), b.into()))
+            .collect()
+    }
+
+    /// Iterates over the live objects in slot order.
+    pub fn iter(&self) -> impl Iterator<Item = (ObjectHandle, &CollisionObject)> {
+        self.objects.iter().flatten().map(|o| (o.handle, o))
+    }
+}
