@@ -114,6 +114,21 @@ pub fn project_point_local(shape: &Shape, p: Vec3) -> PointProjection {
                 ..best
             }
         }
+        Shape::HeightField(m) => {
+            let mut best = proj(p, Real::INFINITY);
+            for i in 0..m.num_triangles() {
+                let [a, b, c] = m.triangle(i);
+                let q = closest_point_triangle(p, a, b, c);
+                let d = (p - q).length();
+                if d < best.distance {
+                    best = proj(q, d);
+                }
+            }
+            PointProjection {
+                inside: false,
+                ..best
+            }
+        }
         Shape::Compound(c) => {
             let mut best: Option<PointProjection> = None;
             for (pose, child) in c.children() {

@@ -173,6 +173,24 @@ pub fn raycast_local(shape: &Shape, ray: &Ray, max_distance: Real, solid: bool) 
             }
             best
         }
+        Shape::HeightField(m) => {
+            let mut best: Option<RayHit> = None;
+            for i in 0..m.num_triangles() {
+                let [a, b, c] = m.triangle(i);
+                if let Some((t, n)) = ray_triangle(o, d, a, b, c) {
+                    if t >= 0.0 && t <= max_distance && best.is_none_or(|h| t < h.distance) {
+                        best = Some(RayHit {
+                            distance: t,
+                            point: o + d * t,
+                            normal: n.normalize(),
+                            inside: false,
+                            feature: Some(i as u32),
+                        });
+                    }
+                }
+            }
+            best
+        }
         Shape::Compound(c) => {
             let mut best: Option<RayHit> = None;
             for (k, (pose, child)) in c.children().iter().enumerate() {
