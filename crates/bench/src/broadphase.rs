@@ -40,8 +40,9 @@ pub struct Args {
     /// Timed frames per run (default: 60 / 30 / 10 / 3 frames from 1k / 8k / 32k / 128k up).
     #[arg(long)]
     pub frames: Option<usize>,
-    /// Scale the curve with N (amplitude 100·N/8192) so the density, and the pairs per
-    /// box, stay constant; the default keeps CDTestFramework's fixed world.
+    /// Scale the curve with N (amplitude 100·(N/8192)^(1/3): the boxes fill a volume, so
+    /// the density and the pairs per box stay about constant); the default keeps
+    /// CDTestFramework's fixed world, where pairs grow as N².
     #[arg(long)]
     pub constant_density: bool,
     /// Largest N for the O(N²) brute force.
@@ -268,7 +269,7 @@ pub fn run(args: &Args) -> Result<(), String> {
     for &n in &args.sizes {
         let frames = args.frames.unwrap_or_else(|| frames_for(n)).max(1);
         let amp = if args.constant_density {
-            100.0 * n as f64 / 8192.0
+            100.0 * (n as f64 / 8192.0).cbrt()
         } else {
             100.0
         };
