@@ -25,7 +25,16 @@ pub type Cell = [i32; 3];
 /// merges very distant cells: still conservative).
 #[inline]
 pub fn cell_of(p: Vec3, inv: Real) -> Cell {
-    let c = |x: Real| (x * inv).floor().clamp(i32::MIN as Real, i32::MAX as Real) as i32;
+    // Inline floor (no libm call): truncate, then step down for negative non-integers.
+    let c = |x: Real| {
+        let v = (x * inv).clamp(i32::MIN as Real, i32::MAX as Real);
+        let t = v as i32;
+        if (t as Real) > v {
+            t - 1
+        } else {
+            t
+        }
+    };
     [c(p.x), c(p.y), c(p.z)]
 }
 
@@ -46,6 +55,9 @@ pub struct CellEntry {
     pub key: u64,
     /// The cell.
     pub cell: Cell,
+    /// True when the box lies in this one cell only: a pair with such a box can only be
+    /// found here, so the lowest-common-cell test is skipped.
+    pub single: bool,
 }
 
 impl CellEntry {
@@ -77,6 +89,7 @@ impl GridLevel {
         for &id in ids {
             let b = &boxes[id as usize];
             let (lo, hi) = (cell_of(b.min, inv), cell_of(b.max, inv));
+            let single = lo == hi;
             for x in lo[0]..=hi[0] {
                 for y in lo[1]..=hi[1] {
                     for z in lo[2]..=hi[2] {
@@ -84,37 +97,81 @@ impl GridLevel {
                         entries.push(CellEntry {
                             key: ((hash_cell(cell) as u64) << 32) | id as u64,
                             cell,
+                            single,
                         });
                     }
                 }
             }
         }
-        radix_sort_by_key(&mut entries, scratch, |e| e.key);
+        // Entries were pushed in id order and the radix sort is stable: sorting on the hash
+        // alone leaves each bucket in id order (3 passes instead of 5).
+        radix_sort_by_key(&mut entries, scratch, |e| e.key >> 32);
         GridLevel { inv, entries }
     }
 
     /// Pairs among the boxes of this level, each reported once (in its lowest common cell).
+    /// Buckets are processed in parallel in fixed-size groups (the output is sorted later).
     pub fn self_pairs(&self, boxes: &[Aabb], out: &mut Vec<u64>) {
+        // Bucket boundaries, then groups of about PAIR_CHUNK entries cut at boundaries.
+        const PAIR_CHUNK: usize = 4096;
         let e = &self.entries;
-        let mut start = 0;
-        while start < e.len() {
+        let mut cuts = vec![0usize];
+        let mut i = 0;
+        while i < e.len() {
+            let h = e[i].key >> 32;
+            i += 1;
+            while i < e.len() && e[i].key >> 32 == h {
+                i += 1;
+            }
+            if i - cuts[cuts.len() - 1] >= PAIR_CHUNK || i == e.len() {
+                cuts.push(i);
+            }
+        }
+        let run = |lo: usize, hi: usize| {
+            let mut out = Vec::new();
+            self.pairs_in(boxes, lo, hi, &mut out);
+            out
+        };
+        #[cfg(feature = "parallel")]
+        {
+            use rayon::prelude::*;
+            let parts: Vec<Vec<u64>> = cuts.par_windows(2).map(|w| run(w[0], w[1])).collect();
+            for p in parts {
+                out.extend_from_slice(&p);
+            }
+        }
+        #[cfg(not(feature = "parallel"))]
+        for w in cuts.windows(2) {
+            out.extend_from_slice(&run(w[0], w[1]));
+        }
+    }
+
+    /// Pairs within the buckets that make up `entries[lo..hi]`.
+    fn pairs_in(&self, boxes: &[Aabb], lo: usize, hi: usize, out: &mut Vec<u64>) {
+        let e = &self.entries[..hi];
+        let mut start = lo;
+        while start < hi {
             let h = e[start].key >> 32;
             let mut end = start + 1;
-            while end < e.len() && e[end].key >> 32 == h {
+            while end < hi && e[end].key >> 32 == h {
                 end += 1;
             }
             for p in start..end {
-                for q in p + 1..end {
-                    if e[p].cell != e[q].cell {
+                let ep = e[p];
+                let ba = &boxes[ep.id() as usize];
+                for eq in &e[p + 1..end] {
+                    if ep.cell != eq.cell {
                         continue;
                     }
-                    let (a, b) = (e[p].id(), e[q].id());
-                    let (ba, bb) = (&boxes[a as usize], &boxes[b as usize]);
-                    if a != b
-                        && ba.intersects(bb)
-                        && cell_of(ba.min.max(bb.min), self.inv) == e[p].cell
+                    let b = eq.id();
+                    let bb = &boxes[b as usize];
+                    if ba.intersects(bb)
+                        && ep.id() != b
+                        && (ep.single
+                            || eq.single
+                            || cell_of(ba.min.max(bb.min), self.inv) == ep.cell)
                     {
-                        out.push(pair_key(a, b));
+                        out.push(pair_key(ep.id(), b));
                     }
                 }
             }

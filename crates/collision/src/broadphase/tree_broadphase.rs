@@ -65,6 +65,19 @@ impl TreeBroadPhase {
         }
     }
 
+    /// Sets how many times the predicted displacement the fat boxes are swept by (both
+    /// trees; see [`DynamicTree::set_motion_scale`]).
+    pub fn set_motion_scale(&mut self, scale: Real) {
+        for t in &mut self.trees {
+            t.set_motion_scale(scale);
+        }
+    }
+
+    /// Number of candidate pairs (fat boxes overlapping) after the last update.
+    pub fn candidate_count(&self) -> usize {
+        self.candidates.len()
+    }
+
     /// The moving tree (index 0) or the resting tree (index 1).
     pub fn tree(&self, which: usize) -> &DynamicTree {
         &self.trees[which.min(1)]

@@ -186,44 +186,48 @@ impl DynamicTree {
     }
 
     /// Calls `f(user_a, user_b)` once for every unordered pair of distinct leaves whose fat
-    /// boxes intersect: the self-pair sweep (Bullet's `collideTT(root, root)`).
+    /// boxes intersect: the self-pair sweep (Bullet's `collideTT(root, root)`). Child pairs
+    /// are tested before they are pushed, so the stack only holds overlapping pairs.
     pub fn self_pairs(&self, mut f: impl FnMut(u32, u32)) {
         if self.root == NULL {
             return;
         }
+        let nodes = &self.nodes;
         let mut stack: Vec<(u32, u32)> = Vec::with_capacity(128);
         stack.push((self.root, self.root));
+        let push = |stack: &mut Vec<(u32, u32)>, a: u32, b: u32| {
+            if nodes[a as usize].aabb.intersects(&nodes[b as usize].aabb) {
+                stack.push((a, b));
+            }
+        };
         while let Some((a, b)) = stack.pop() {
-            let na = &self.nodes[a as usize];
+            let na = &nodes[a as usize];
             if a == b {
                 if !na.is_leaf() {
                     stack.push((na.child1, na.child1));
                     stack.push((na.child2, na.child2));
-                    stack.push((na.child1, na.child2));
+                    push(&mut stack, na.child1, na.child2);
                 }
                 continue;
             }
-            let nb = &self.nodes[b as usize];
-            if !na.aabb.intersects(&nb.aabb) {
-                continue;
-            }
+            let nb = &nodes[b as usize];
             match (na.is_leaf(), nb.is_leaf()) {
                 (true, true) => f(na.user, nb.user),
                 (true, false) => {
-                    stack.push((a, nb.child1));
-                    stack.push((a, nb.child2));
+                    push(&mut stack, a, nb.child1);
+                    push(&mut stack, a, nb.child2);
                 }
                 (false, true) => {
-                    stack.push((na.child1, b));
-                    stack.push((na.child2, b));
+                    push(&mut stack, na.child1, b);
+                    push(&mut stack, na.child2, b);
                 }
                 (false, false) => {
                     if na.height >= nb.height {
-                        stack.push((na.child1, b));
-                        stack.push((na.child2, b));
+                        push(&mut stack, na.child1, b);
+                        push(&mut stack, na.child2, b);
                     } else {
-                        stack.push((a, nb.child1));
-                        stack.push((a, nb.child2));
+                        push(&mut stack, a, nb.child1);
+                        push(&mut stack, a, nb.child2);
                     }
                 }
             }
