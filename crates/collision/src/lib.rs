@@ -15,6 +15,7 @@
 pub mod error;
 pub mod math;
 pub mod midphase;
+pub mod query;
 pub mod shape;
 
 pub use error::{CaromError, Result};

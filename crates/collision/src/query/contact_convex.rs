@@ -1,0 +1,167 @@
+//! Contact between two convex shapes in A's frame (B placed by `pose_ab`): the dispatcher
+//! that picks an exact special case by shape kinds, and the general GJK + EPA path.
+//!
+//! The general path follows the talk's margins: GJK runs on the *cores* (a sphere's centre,
+//! a capsule's segment, every other shape exactly) and the radii are added back, which is
+//! exact for the user's shape; when the cores themselves overlap, EPA runs on the cores
+//! (the Minkowski difference of two rounded shapes is the cores' difference rounded by
+//! `ra + rb`, so the depth is the cores' depth plus `ra + rb`, still exact). If the cores'
+//! difference is flat (segment against segment), EPA runs on the full shapes.
+
+use super::contact_cuboid_cuboid::contact_cuboid_cuboid;
+use super::contact_round::{
+    contact_capsule_capsule, contact_sphere_capsule, contact_sphere_cuboid, contact_sphere_sphere,
+    contact_sphere_triangle,
+};
+use super::epa::{epa, epa_polytope};
+use super::gjk::{gjk, gjk_intersects, GjkResult};
+use super::result::Contact;
+use super::support_adapters::{core_radius, AddRadius, Core, Transformed};
+use crate::math::{Isometry, Real, Vec3};
+use crate::shape::ConvexRef;
+
+/// Runs `f` with A and B exchanged (`f` receives `pose_ba`) and maps its answer back to A's
+/// frame: the one generic adapter that serves every reversed pair.
+#[inline]
+pub fn swap_contact(
+    pose_ab: &Isometry,
+    f: impl FnOnce(&Isometry) -> Option<Contact>,
+) -> Option<Contact> {
+    let pose_ba = pose_ab.inverse();
+    f(&pose_ba).map(|c| c.swapped().transformed(pose_ab))
+}
+
+/// Contact of two convex shapes in A's frame, or `None` when they are further apart than
+/// `prediction`. Dispatches to an exact special case when one exists (sphere–sphere,
+/// sphere–box, sphere–capsule, sphere–triangle, capsule–capsule, box–box) and to
+/// [`contact_gjk_epa`] otherwise.
+pub fn contact_convex(
+    a: ConvexRef<'_>,
+    b: ConvexRef<'_>,
+    pose_ab: &Isometry,
+    prediction: Real,
+) -> Option<Contact> {
+    use ConvexRef as C;
+    match (a, b) {
+        (C::Sphere(a), C::Sphere(b)) => contact_sphere_sphere(a, b, pose_ab, prediction),
+        (C::Sphere(a), C::Cuboid(b)) => contact_sphere_cuboid(a, b, pose_ab, prediction),
+        (C::Cuboid(a), C::Sphere(b)) => {
+            swap_contact(pose_ab, |p| contact_sphere_cuboid(b, a, p, prediction))
+        }
+        (C::Sphere(a), C::Capsule(b)) => contact_sphere_capsule(a, b, pose_ab, prediction),
+        (C::Capsule(a), C::Sphere(b)) => {
+            swap_contact(pose_ab, |p| contact_sphere_capsule(b, a, p, prediction))
+        }
+        (C::Sphere(a), C::Triangle(b)) => contact_sphere_triangle(a, b, pose_ab, prediction),
+        (C::Triangle(a), C::Sphere(b)) => {
+            swap_contact(pose_ab, |p| contact_sphere_triangle(b, a, p, prediction))
+        }
+        (C::Capsule(a), C::Capsule(b)) => contact_capsule_capsule(a, b, pose_ab, prediction),
+        (C::Cuboid(a), C::Cuboid(b)) => contact_cuboid_cuboid(a, b, pose_ab, prediction),
+        _ => contact_gjk_epa(a, b, pose_ab, prediction),
+    }
+}
+
+/// The general path: GJK on cores plus radii, EPA when the cores overlap. Works for every
+/// pair of convex shapes; `None` when further apart than `prediction`.
+pub fn contact_gjk_epa(
+    a: ConvexRef<'_>,
+    b: ConvexRef<'_>,
+    pose_ab: &Isometry,
+    prediction: Real,
+) -> Option<Contact> {
+    let (ra, rb) = (core_radius(a), core_radius(b));
+    let radius = ra + rb;
+    let core_a = Core(a);
+    let core_b = Transformed::new(Core(b), pose_ab);
+    let dir = -pose_ab.translation;
+    match gjk(&core_a, &core_b, dir, prediction + radius) {
+        GjkResult::BeyondMaxDistance => None,
+        GjkResult::Separated {
+            distance,
+            point_a,
+            point_b,
+        } => {
+            let signed = distance - radius;
+            if signed > prediction {
+                return None;
+            }
+            let n = (point_b - point_a) / distance;
+            Some(Contact {
+                distance: signed,
+                point_a: point_a + n * ra,
+                point_b: point_b - n * rb,
+                normal: n,
+            })
+        }
+        GjkResult::Overlapping(simplex) => {
+            let pen = if radius > 0.0 {
+                epa_polytope(&core_a, &core_b, &simplex).map(|p| (p, ra, rb))
+            } else {
+                None
+            };
+            let (pen, ra, rb) = pen.unwrap_or_else(|| {
+                // Full shapes: exact support including the radius.
+                let full_a = AddRadius {
+                    inner: core_a,
+                    radius: ra,
+                };
+                let full_b = Transformed::new(
+                    AddRadius {
+                        inner: Core(b),
+                        radius: rb,
+                    },
+                    pose_ab,
+                );
+                let p = match gjk(&full_a, &full_b, dir, Real::INFINITY) {
+                    GjkResult::Overlapping(s) => epa(&full_a, &full_b, &s),
+                    _ => epa(&full_a, &full_b, &simplex),
+                };
+                (p, 0.0, 0.0)
+            });
+            let depth = pen.depth + ra + rb;
+            if -depth > prediction {
+                return None;
+            }
+            let n = pen.normal;
+            Some(Contact {
+                distance: -depth,
+                point_a: pen.point_a + n * ra,
+                point_b: pen.point_b - n * rb,
+                normal: n,
+            })
+        }
+    }
+}
+
+/// Signed distance of two convex shapes in A's frame (always a result).
+pub fn distance_convex(a: ConvexRef<'_>, b: ConvexRef<'_>, pose_ab: &Isometry) -> Contact {
+    contact_convex(a, b, pose_ab, Real::INFINITY).unwrap_or(Contact {
+        // Unreachable with an infinite prediction; kept total and finite.
+        distance: Real::MAX,
+        point_a: Vec3::ZERO,
+        point_b: pose_ab.translation,
+        normal: Vec3::Y,
+    })
+}
+
+/// True when two convex shapes touch or overlap. GJK on the cores with an early exit on the
+/// first separating axis (no EPA, no witness points).
+pub fn intersects_convex(a: ConvexRef<'_>, b: ConvexRef<'_>, pose_ab: &Isometry) -> bool {
+    use ConvexRef as C;
+    match (a, b) {
+        (C::Sphere(a), C::Sphere(b)) => {
+            let r = a.radius() + b.radius();
+            pose_ab.translation.length_squared() <= r * r
+        }
+        _ => {
+            let radius = core_radius(a) + core_radius(b);
+            gjk_intersects(
+                &Core(a),
+                &Transformed::new(Core(b), pose_ab),
+                -pose_ab.translation,
+                radius,
+            )
+        }
+    }
+}

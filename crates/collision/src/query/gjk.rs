@@ -1,0 +1,289 @@
+//! GJK: closest points between two convex sets given by support functions.
+//!
+//! Gilbert, Johnson and Keerthi (1988), in the form of van den Bergen, "Collision Detection
+//! in Interactive 3D Environments" (2003), with the signed-volumes sub-algorithm and the
+//! termination criteria of Montanari et al. (2017) (see [`super::simplex`]):
+//!
+//! 1. `v` is the current closest point of the simplex to the origin (a point of `A - B`).
+//! 2. `w = s_{A-B}(-v)`; `v·w / |v|` is a lower bound of the distance, `|v|` an upper bound.
+//! 3. Stop when the bounds meet within a relative tolerance, when `w` is already in the
+//!    simplex, when `|v|` stops decreasing (round-off), or after [`GJK_MAX_ITERATIONS`].
+//! 4. The origin is inside (the sets overlap) when the simplex becomes a tetrahedron that
+//!    contains it, or when `|v|` falls below a scale-relative tolerance.
+//!
+//! Witness points come from the same barycentric weights applied to the support points on
+//! A and on B. Everything here is in A's frame; callers place B with a
+//! [`super::support_adapters::Transformed`] adapter.
+
+use super::simplex::closest_to_origin;
+use super::support_adapters::{MinkowskiDiff, Support};
+use crate::math::{Real, Vec3, EPSILON};
+
+/// Iteration cap of GJK (a polytope pair converges in far fewer; smooth shapes stop on the
+/// relative tolerance long before).
+pub const GJK_MAX_ITERATIONS: usize = 64;
+
+/// Relative tolerance on the duality gap `|v|² - v·w <= GJK_REL_TOL · |v|²`.
+pub const GJK_REL_TOL: Real = 16.0 * EPSILON;
+
+/// Scale-relative tolerance below which `|v|` counts as zero (the sets touch or overlap).
+pub const GJK_ZERO_TOL: Real = 32.0 * EPSILON;
+
+/// The GJK simplex: up to four points of `A - B` with their support points on A and B.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Simplex {
+    /// Points of the Minkowski difference.
+    pub w: [Vec3; 4],
+    /// Support points on A.
+    pub a: [Vec3; 4],
+    /// Support points on B.
+    pub b: [Vec3; 4],
+    /// Barycentric weights of the closest point.
+    pub lambda: [Real; 4],
+    /// Number of points in use.
+    pub len: usize,
+}
+
+impl Simplex {
+    fn push(&mut self, w: Vec3, a: Vec3, b: Vec3) {
+        self.w[self.len] = w;
+        self.a[self.len] = a;
+        self.b[self.len] = b;
+        self.lambda[self.len] = 0.0;
+        self.len += 1;
+    }
+
+    /// Reduces to the support set of the closest point and returns that point.
+    fn solve(&mut self) -> Vec3 {
+        let sol = closest_to_origin(&self.w[..self.len]);
+        let mut out = Simplex::default();
+        for i in 0..self.len {
+            if sol.mask & (1 << i) != 0 {
+                out.push(self.w[i], self.a[i], self.b[i]);
+                out.lambda[out.len - 1] = sol.lambda[i];
+            }
+        }
+        *self = out;
+        self.closest()
+    }
+
+    /// The closest point `Σ λᵢ wᵢ`.
+    pub fn closest(&self) -> Vec3 {
+        (0..self.len).fold(Vec3::ZERO, |acc, i| acc + self.w[i] * self.lambda[i])
+    }
+
+    /// Witness points `(Σ λᵢ aᵢ, Σ λᵢ bᵢ)`.
+    pub fn witnesses(&self) -> (Vec3, Vec3) {
+        let mut pa = Vec3::ZERO;
+        let mut pb = Vec3::ZERO;
+        for i in 0..self.len {
+            pa += self.a[i] * self.lambda[i];
+            pb += self.b[i] * self.lambda[i];
+        }
+        (pa, pb)
+    }
+
+    fn contains(&self, w: Vec3) -> bool {
+        self.w[..self.len].contains(&w)
+    }
+
+    fn max_norm_sq(&self) -> Real {
+        self.w[..self.len]
+            .iter()
+            .map(|w| w.length_squared())
+            .fold(0.0, Real::max)
+    }
+}
+
+/// Outcome of [`gjk`].
+#[derive(Debug, Clone, Copy)]
+#[allow(clippy::large_enum_variant)] // returned by value once per query; boxing would allocate
+pub enum GjkResult {
+    /// The sets are apart: closest points on A and B (A's frame) and their distance.
+    Separated {
+        /// Distance between the sets (`|point_b - point_a|`).
+        distance: Real,
+        /// Closest point on A.
+        point_a: Vec3,
+        /// Closest point on B.
+        point_b: Vec3,
+    },
+    /// The lower bound proved the distance larger than the requested `max_distance`.
+    BeyondMaxDistance,
+    /// The sets touch or overlap; the simplex is the starting point for EPA.
+    Overlapping(Simplex),
+}
+
+/// GJK closest points between `a` and `b` (both in the same frame).
+///
+/// `initial_dir` seeds the search (e.g. the vector between the centres). When
+/// `max_distance` is finite, the search stops as soon as the lower bound exceeds it.
+pub fn gjk<A: Support, B: Support>(
+    a: &A,
+    b: &B,
+    initial_dir: Vec3,
+    max_distance: Real,
+) -> GjkResult {
+    let diff = MinkowskiDiff { a, b };
+    let d0 = if initial_dir.length_squared() > 0.0 && initial_dir.is_finite() {
+        initial_dir
+    } else {
+        Vec3::X
+    };
+    let mut simplex = Simplex::default();
+    let (w, pa, pb) = diff.support_pair(-d0);
+    simplex.push(w, pa, pb);
+    simplex.lambda[0] = 1.0;
+    let mut v = w;
+    let mut prev;
+    let mut scale_sq = w.length_squared();
+    for _ in 0..GJK_MAX_ITERATIONS {
+        let vv = v.length_squared();
+        if vv <= GJK_ZERO_TOL * GJK_ZERO_TOL * scale_sq || !vv.is_finite() {
+            return GjkResult::Overlapping(simplex);
+        }
+        let (w, pa, pb) = diff.support_pair(-v);
+        scale_sq = scale_sq.max(w.length_squared());
+        let vw = v.dot(w);
+        if max_distance.is_finite() && vw > 0.0 && vw * vw > vv * max_distance * max_distance {
+            return GjkResult::BeyondMaxDistance;
+        }
+        if vv - vw <= GJK_REL_TOL * vv || simplex.contains(w) {
+            break;
+        }
+        prev = simplex;
+        simplex.push(w, pa, pb);
+        let new_v = simplex.solve();
+        if simplex.len == 4 {
+            return GjkResult::Overlapping(simplex);
+        }
+        let new_vv = new_v.length_squared();
+        if new_vv >= vv {
+            // No progress: round-off. Keep the previous, better simplex.
+            simplex = prev;
+            break;
+        }
+        scale_sq = scale_sq.max(simplex.max_norm_sq());
+        v = new_v;
+    }
+    let vv = v.length_squared();
+    if vv <= GJK_ZERO_TOL * GJK_ZERO_TOL * scale_sq {
+        return GjkResult::Overlapping(simplex);
+    }
+    let (point_a, point_b) = simplex.witnesses();
+    GjkResult::Separated {
+        distance: vv.sqrt(),
+        point_a,
+        point_b,
+    }
+}
+
+/// Boolean GJK: true when the sets, each swept by the given radius sum `radius`, intersect
+/// (distance <= `radius`). Exits as soon as a separating axis is found (`v·w > radius |v|`).
+pub fn gjk_intersects<A: Support, B: Support>(
+    a: &A,
+    b: &B,
+    initial_dir: Vec3,
+    radius: Real,
+) -> bool {
+    let diff = MinkowskiDiff { a, b };
+    let d0 = if initial_dir.length_squared() > 0.0 && initial_dir.is_finite() {
+        initial_dir
+    } else {
+        Vec3::X
+    };
+    let mut simplex = Simplex::default();
+    let (w, pa, pb) = diff.support_pair(-d0);
+    simplex.push(w, pa, pb);
+    simplex.lambda[0] = 1.0;
+    let mut v = w;
+    let mut scale_sq = w.length_squared();
+    for _ in 0..GJK_MAX_ITERATIONS {
+        let vv = v.length_squared();
+        if vv <= radius * radius || vv <= GJK_ZERO_TOL * GJK_ZERO_TOL * scale_sq {
+            return true;
+        }
+        let (w, pa, pb) = diff.support_pair(-v);
+        scale_sq = scale_sq.max(w.length_squared());
+        let vw = v.dot(w);
+        if vw > 0.0 && vw * vw > vv * radius * radius {
+            return false; // separating axis
+        }
+        if vv - vw <= GJK_REL_TOL * vv || simplex.contains(w) {
+            // Converged: the distance is |v|.
+            return vv <= radius * radius * (1.0 + GJK_REL_TOL);
+        }
+        let prev_v = v;
+        simplex.push(w, pa, pb);
+        v = simplex.solve();
+        if simplex.len == 4 {
+            return true;
+        }
+        if v.length_squared() >= prev_v.length_squared() {
+            return prev_v.length_squared() <= radius * radius;
+        }
+    }
+    v.length_squared() <= radius * radius
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::query::support_adapters::{PointSupport, PolytopeSupport, SegmentSupport};
+
+    #[test]
+    fn point_to_segment_and_box() {
+        let seg = SegmentSupport(Vec3::new(-1.0, 2.0, 0.0), Vec3::new(1.0, 2.0, 0.0));
+        match gjk(&PointSupport(Vec3::ZERO), &seg, Vec3::Y, Real::INFINITY) {
+            GjkResult::Separated {
+                distance, point_b, ..
+            } => {
+                assert!((distance - 2.0).abs() < 1e-5);
+                assert!((point_b - Vec3::new(0.0, 2.0, 0.0)).length() < 1e-5);
+            }
+            r => panic!("{r:?}"),
+        }
+        let cube: Vec<Vec3> = (0..8)
+            .map(|i| {
+                Vec3::new(
+                    if i & 1 != 0 { 1.0 } else { -1.0 },
+                    if i & 2 != 0 { 1.0 } else { -1.0 },
+                    if i & 4 != 0 { 1.0 } else { -1.0 },
+                )
+            })
+            .collect();
+        let c = PolytopeSupport(&cube);
+        assert!(matches!(
+            gjk(
+                &PointSupport(Vec3::new(0.5, 0.2, 0.1)),
+                &c,
+                Vec3::X,
+                Real::INFINITY
+            ),
+            GjkResult::Overlapping(_)
+        ));
+        match gjk(
+            &PointSupport(Vec3::new(3.0, 4.0, 0.5)),
+            &c,
+            Vec3::X,
+            Real::INFINITY,
+        ) {
+            GjkResult::Separated { distance, .. } => {
+                assert!((distance - (13.0 as Real).sqrt()).abs() < 1e-5)
+            }
+            r => panic!("{r:?}"),
+        }
+        assert!(!gjk_intersects(
+            &PointSupport(Vec3::new(3.0, 0.0, 0.0)),
+            &c,
+            Vec3::X,
+            1.5
+        ));
+        assert!(gjk_intersects(
+            &PointSupport(Vec3::new(3.0, 0.0, 0.0)),
+            &c,
+            Vec3::X,
+            2.5
+        ));
+    }
+}

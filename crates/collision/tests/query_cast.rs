@@ -1,0 +1,274 @@
+//! Shape casts against bisection on the signed distance, and conservative advancement
+//! against fine time sampling.
+
+#[path = "query_common/mod.rs"]
+mod common;
+
+use carom_collision::math::{Isometry, Real, Vec3};
+use carom_collision::query::{distance, shape_cast, time_of_impact, Motion};
+use carom_collision::shape::{Capsule, Cone, Cuboid, Cylinder, Shape, Sphere};
+use common::*;
+
+fn shapes(rng: &mut Rng) -> Vec<Shape> {
+    vec![
+        Shape::Sphere(Sphere::new(0.4).unwrap()),
+        Shape::Cuboid(Cuboid::new(Vec3::new(0.4, 0.3, 0.5)).unwrap()),
+        Shape::Capsule(Capsule::new(0.25, 0.4).unwrap()),
+        Shape::Cylinder(Cylinder::new(0.3, 0.4).unwrap()),
+        Shape::Cone(Cone::new(0.4, 0.4).unwrap()),
+        Shape::ConvexHull(random_hull(rng, 16, 0.5)),
+    ]
+}
+
+/// Signed distance at time t of a linear motion.
+fn dist_at(
+    a: &Shape,
+    pa: &Isometry,
+    va: Vec3,
+    b: &Shape,
+    pb: &Isometry,
+    vb: Vec3,
+    t: Real,
+) -> Real {
+    let ma = Isometry::new(pa.translation + va * t, pa.rotation);
+    let mb = Isometry::new(pb.translation + vb * t, pb.rotation);
+    distance(a, &ma, b, &mb).unwrap().distance
+}
+
+#[test]
+fn shape_cast_matches_bisection_on_distance() {
+    let mut rng = Rng(21);
+    let all = shapes(&mut rng);
+    let tol_t = if std::mem::size_of::<Real>() == 8 {
+        1e-6
+    } else {
+        1e-3
+    };
+    let (mut hits, mut misses) = (0, 0);
+    for a in &all {
+        for b in &all {
+            for _ in 0..8 {
+                let pa = rng.pose(0.5);
+                let pb = Isometry::new(pa.translation + rng.unit() * 2.5, rng.quat());
+                let va = rng.vec(0.5);
+                let vb = (pa.translation - pb.translation) * rng.range(0.5, 1.5) + rng.vec(0.8);
+                let got = shape_cast(a, &pa, va, b, &pb, vb, 1.0).unwrap();
+                // Oracle: first sign change of the distance on a grid, refined by bisection.
+                let n = 400;
+                let mut want = None;
+                let mut prev = 0.0;
+                for k in 0..=n {
+                    let t = k as Real / n as Real;
+                    if dist_at(a, &pa, va, b, &pb, vb, t) <= 0.0 {
+                        let (mut lo, mut hi) = (prev, t);
+                        for _ in 0..50 {
+                            let mid = 0.5 * (lo + hi);
+                            if dist_at(a, &pa, va, b, &pb, vb, mid) <= 0.0 {
+                                hi = mid;
+                            } else {
+                                lo = mid;
+                            }
+                        }
+                        want = Some(hi);
+                        break;
+                    }
+                    prev = t;
+                }
+                match (got, want) {
+                    (Some(h), Some(t)) => {
+                        hits += 1;
+                        assert!(
+                            (h.toi - t).abs() < tol_t,
+                            "{} {}: {} vs {t}",
+                            a.kind_name(),
+                            b.kind_name(),
+                            h.toi
+                        );
+                        assert!((h.normal.length() - 1.0).abs() < 1e-3);
+                        // Touching at toi: witnesses coincide.
+                        assert!(
+                            (h.point_a - h.point_b).length() < 1e-3,
+                            "{} {}: {h:?} {t}",
+                            a.kind_name(),
+                            b.kind_name()
+                        );
+                    }
+                    (None, None) => misses += 1,
+                    (g, w) => {
+                        // Grazing contacts may fall between grid samples: accept if the
+                        // minimum distance is within tolerance of zero.
+                        let t = g.map(|h| h.toi).or(w).unwrap();
+                        let d = dist_at(a, &pa, va, b, &pb, vb, t);
+                        assert!(
+                            d.abs() < 1e-3,
+                            "{} {}: {g:?} vs {w:?} (d = {d})",
+                            a.kind_name(),
+                            b.kind_name()
+                        );
+                    }
+                }
+            }
+        }
+    }
+    assert!(hits > 60 && misses > 20, "{hits} hits, {misses} misses");
+}
+
+#[test]
+fn conservative_advancement_matches_time_sampling() {
+    let mut rng = Rng(22);
+    let all = shapes(&mut rng);
+    let tol = 1e-3;
+    let (mut hits, mut misses) = (0, 0);
+    for a in &all {
+        for b in &all {
+            for _ in 0..5 {
+                let ma = Motion::new(rng.pose(0.5), rng.vec(0.5), rng.vec(4.0)).unwrap();
+                let pb = Isometry::new(ma.pose.translation + rng.unit() * 2.5, rng.quat());
+                let vb =
+                    (ma.pose.translation - pb.translation) * rng.range(0.5, 1.5) + rng.vec(0.8);
+                let mb = Motion::new(pb, vb, rng.vec(4.0)).unwrap();
+                let got = time_of_impact(a, &ma, b, &mb, 1.0, tol).unwrap();
+                let d_at = |t: Real| {
+                    distance(a, &ma.pose_at(t), b, &mb.pose_at(t))
+                        .unwrap()
+                        .distance
+                };
+                let n = 1000;
+                let want = (0..=n)
+                    .map(|k| k as Real / n as Real)
+                    .find(|&t| d_at(t) <= tol);
+                match (got, want) {
+                    (Some(h), Some(t)) => {
+                        hits += 1;
+                        // Conservative: never after the sampled first contact (one step of slack),
+                        // and at the reported time the shapes are within the tolerance.
+                        assert!(
+                            h.toi <= t + 1e-3,
+                            "{} {}: {} vs {t}",
+                            a.kind_name(),
+                            b.kind_name(),
+                            h.toi
+                        );
+                        assert!(
+                            d_at(h.toi) <= tol * 1.01,
+                            "{} {}: {h:?} {t} {}",
+                            a.kind_name(),
+                            b.kind_name(),
+                            d_at(h.toi)
+                        );
+                        assert!(
+                            h.toi >= t - 2e-3,
+                            "{} {}: {} vs {t}",
+                            a.kind_name(),
+                            b.kind_name(),
+                            h.toi
+                        );
+                    }
+                    (None, None) => misses += 1,
+                    (None, Some(t)) => panic!(
+                        "{} {}: missed the impact at {t}",
+                        a.kind_name(),
+                        b.kind_name()
+                    ),
+                    (Some(h), None) => assert!(d_at(h.toi) <= tol * 1.01, "{h:?}"),
+                }
+            }
+        }
+    }
+    assert!(hits > 30 && misses > 10, "{hits} hits, {misses} misses");
+}
+
+#[test]
+fn cast_edge_cases() {
+    let s = Shape::Sphere(Sphere::new(0.5).unwrap());
+    let id = Isometry::IDENTITY;
+    // Head-on spheres: analytic toi.
+    let far = Isometry::from_translation(Vec3::X * 3.0);
+    let h = shape_cast(&s, &id, Vec3::ZERO, &s, &far, -Vec3::X * 4.0, 1.0)
+        .unwrap()
+        .unwrap();
+    assert!((h.toi - 0.5).abs() < 1e-5, "{h:?}");
+    assert!((h.normal - Vec3::X).length() < 1e-4);
+    // No relative motion, apart: none. Overlapping: toi 0.
+    assert!(shape_cast(&s, &id, Vec3::X, &s, &far, Vec3::X, 1.0)
+        .unwrap()
+        .is_none());
+    let near = Isometry::from_translation(Vec3::X * 0.5);
+    let h = shape_cast(&s, &id, Vec3::ZERO, &s, &near, Vec3::X, 1.0)
+        .unwrap()
+        .unwrap();
+    assert!(h.toi == 0.0 && h.initially_overlapping);
+    // Bad input.
+    assert!(shape_cast(&s, &id, Vec3::splat(Real::NAN), &s, &far, Vec3::X, 1.0).is_err());
+    assert!(shape_cast(&s, &id, Vec3::ZERO, &s, &far, Vec3::X, -1.0).is_err());
+    let m = Motion {
+        pose: id,
+        linvel: Vec3::ZERO,
+        angvel: Vec3::ZERO,
+    };
+    assert!(time_of_impact(&s, &m, &s, &m, 1.0, 0.0).is_err());
+    // A spinning long box hits a nearby sphere it would miss without rotation.
+    let stick = Shape::Cuboid(Cuboid::new(Vec3::new(2.0, 0.05, 0.05)).unwrap());
+    let ms = Motion::new(id, Vec3::ZERO, Vec3::new(0.0, 0.0, 3.0)).unwrap();
+    let ball = Motion::new(
+        Isometry::from_translation(Vec3::new(0.0, 1.5, 0.0)),
+        Vec3::ZERO,
+        Vec3::ZERO,
+    )
+    .unwrap();
+    let h = time_of_impact(&stick, &ms, &s, &ball, 1.0, 1e-4)
+        .unwrap()
+        .unwrap();
+    assert!(h.toi > 0.0 && h.toi < 1.0);
+    let d = distance(&stick, &ms.pose_at(h.toi), &s, &ball.pose)
+        .unwrap()
+        .distance;
+    assert!(d <= 1e-4 && d > -1e-3, "{d}");
+}
+
+#[test]
+fn extreme_values_stay_finite_and_terminate() {
+    use carom_collision::query::{project_point, raycast};
+    let mut rng = Rng(23);
+    let shapes = [
+        Shape::Cuboid(Cuboid::new(Vec3::new(1e-4, 1e3, 1.0)).unwrap()),
+        Shape::ConvexHull(random_hull(&mut rng, 8, 1e-3)),
+        Shape::Cylinder(Cylinder::new(1e3, 1e-3).unwrap()),
+        Shape::Capsule(Capsule::new(1e-4, 1e2).unwrap()),
+        Shape::Cone(Cone::new(1e2, 1e-2).unwrap()),
+    ];
+    for a in &shapes {
+        for mag in [0.0 as Real, 1e-6, 1.0, 1e3, 1e5] {
+            let o = rng.unit() * mag;
+            let d = rng.unit();
+            for solid in [true, false] {
+                if let Some(h) =
+                    raycast(a, &Isometry::IDENTITY, o, d, Real::INFINITY, solid).unwrap()
+                {
+                    assert!(
+                        h.distance.is_finite() && h.point.is_finite() && h.normal.is_finite(),
+                        "{h:?}"
+                    );
+                }
+            }
+            let p = project_point(a, &Isometry::IDENTITY, o).unwrap();
+            assert!(
+                p.distance.is_finite() && p.point.is_finite(),
+                "{} {p:?}",
+                a.kind_name()
+            );
+            for b in &shapes {
+                let pb = Isometry::new(o, rng.quat());
+                let v = rng.unit() * mag;
+                if let Some(h) =
+                    shape_cast(a, &Isometry::IDENTITY, Vec3::ZERO, b, &pb, v, 1.0).unwrap()
+                {
+                    assert!(
+                        h.toi.is_finite() && h.point_a.is_finite() && h.normal.is_finite(),
+                        "{h:?}"
+                    );
+                }
+            }
+        }
+    }
+}

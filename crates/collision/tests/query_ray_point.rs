@@ -1,0 +1,349 @@
+//! Ray casts against dense sampling with an independent inside test (bisection on the first
+//! inside sample), GJK ray casts against analytic ones, and point projection against
+//! brute force and the GJK/EPA path.
+
+#[path = "query_common/mod.rs"]
+mod common;
+
+use carom_collision::math::{Isometry, Real, Vec3};
+use carom_collision::query::point::project_convex_gjk;
+use carom_collision::query::ray::analytic::ray_hull;
+use carom_collision::query::ray::raycast_convex_gjk;
+use carom_collision::query::{project_point, raycast, Ray};
+use carom_collision::shape::{Capsule, Cone, Cuboid, Cylinder, Plane, Shape, Sphere, Triangle};
+use common::*;
+use std::sync::Arc;
+
+/// Independent containment test in the shape's local frame.
+fn inside(shape: &Shape, p: Vec3) -> bool {
+    match shape {
+        Shape::Sphere(s) => p.length() <= s.radius(),
+        Shape::Cuboid(b) => (p.abs() - b.half_extents()).max_element() <= 0.0,
+        Shape::Capsule(c) => {
+            let y = p.y.clamp(-c.half_height(), c.half_height());
+            (p - Vec3::new(0.0, y, 0.0)).length() <= c.radius()
+        }
+        Shape::Cylinder(c) => {
+            Vec3::new(p.x, 0.0, p.z).length() <= c.radius() && p.y.abs() <= c.half_height()
+        }
+        Shape::Cone(c) => {
+            let h = c.half_height();
+            p.y.abs() <= h
+                && Vec3::new(p.x, 0.0, p.z).length() <= c.radius() * (h - p.y) / (2.0 * h)
+        }
+        Shape::ConvexHull(h) => h.faces().iter().all(|f| f.normal.dot(p) <= f.offset),
+        Shape::Scaled(s) => inside(s.inner(), p / s.scale()),
+        Shape::Plane(pl) => pl.signed_distance(p) <= 0.0,
+        _ => false,
+    }
+}
+
+fn shapes(rng: &mut Rng) -> Vec<Shape> {
+    let cube = Arc::new(Shape::Cuboid(
+        Cuboid::new(Vec3::new(0.5, 0.3, 0.4)).unwrap(),
+    ));
+    let cone = Arc::new(Shape::Cone(Cone::new(0.5, 0.6).unwrap()));
+    let cyl = Arc::new(Shape::Cylinder(Cylinder::new(0.4, 0.5).unwrap()));
+    vec![
+        Shape::Sphere(Sphere::new(0.7).unwrap()),
+        Shape::Cuboid(Cuboid::new(Vec3::new(0.5, 0.3, 0.8)).unwrap()),
+        Shape::Capsule(Capsule::new(0.3, 0.6).unwrap()),
+        Shape::Cylinder(Cylinder::new(0.4, 0.5).unwrap()),
+        Shape::Cone(Cone::new(0.5, 0.6).unwrap()),
+        Shape::ConvexHull(random_hull(rng, 24, 0.8)),
+        cube.scaled(Vec3::new(1.5, 0.5, 2.0)).unwrap(),
+        cone.scaled(Vec3::new(1.2, 0.7, 0.9)).unwrap(),
+        cyl.scaled(Vec3::new(0.6, 1.3, 1.0)).unwrap(),
+    ]
+}
+
+/// First parameter in `[0, t_max]` where the ray is inside, by sampling and bisection.
+fn first_inside(shape: &Shape, ray: &Ray, t_max: Real, want: bool) -> Option<Real> {
+    let n = 2000;
+    let mut prev = 0.0;
+    for k in 0..=n {
+        let t = t_max * k as Real / n as Real;
+        if inside(shape, ray.at(t)) == want {
+            if k == 0 {
+                return Some(0.0);
+            }
+            let (mut lo, mut hi) = (prev, t);
+            for _ in 0..60 {
+                let mid = 0.5 * (lo + hi);
+                if inside(shape, ray.at(mid)) == want {
+                    hi = mid;
+                } else {
+                    lo = mid;
+                }
+            }
+            return Some(hi);
+        }
+        prev = t;
+    }
+    None
+}
+
+#[test]
+fn raycasts_match_sampling_oracle() {
+    let mut rng = Rng(11);
+    let tol_t = if std::mem::size_of::<Real>() == 8 {
+        1e-7
+    } else {
+        2e-4
+    };
+    for shape in shapes(&mut rng) {
+        let (mut hits, mut misses) = (0, 0);
+        for _ in 0..120 {
+            let origin = rng.unit() * rng.range(1.5, 3.0);
+            let target = rng.vec(0.6);
+            let ray = Ray::new(origin, target - origin).unwrap();
+            let pose = Isometry::IDENTITY;
+            let got = raycast(&shape, &pose, ray.origin, ray.dir, 10.0, true).unwrap();
+            let want = first_inside(&shape, &ray, 6.0, true);
+            match (got, want) {
+                (Some(h), Some(t)) => {
+                    hits += 1;
+                    assert!(
+                        (h.distance - t).abs() < tol_t,
+                        "{}: {} vs {t}",
+                        shape.kind_name(),
+                        h.distance
+                    );
+                    assert!(!h.inside && h.normal.dot(ray.dir) <= 1e-4, "{h:?}");
+                    assert!((h.normal.length() - 1.0).abs() < 1e-4);
+                    // Slightly inside along the normal.
+                    assert!(
+                        inside(&shape, h.point - h.normal * 1e-3),
+                        "{} {h:?}",
+                        shape.kind_name()
+                    );
+                }
+                (None, None) => misses += 1,
+                (g, w) => panic!("{}: got {g:?}, oracle {w:?}", shape.kind_name()),
+            }
+        }
+        assert!(
+            hits > 20 && misses > 5,
+            "{}: {hits} hits {misses} misses",
+            shape.kind_name()
+        );
+        // Rays starting inside: solid -> 0, hollow -> the exit.
+        for _ in 0..30 {
+            let origin = rng.vec(0.05);
+            let dir = rng.unit();
+            let ray = Ray::new(origin, dir).unwrap();
+            let pose = Isometry::IDENTITY;
+            let s = raycast(&shape, &pose, origin, dir, 10.0, true)
+                .unwrap()
+                .unwrap();
+            assert!(s.inside && s.distance == 0.0);
+            let h = raycast(&shape, &pose, origin, dir, 10.0, false)
+                .unwrap()
+                .unwrap();
+            let exit = first_inside(&shape, &ray, 6.0, false).unwrap();
+            assert!(
+                h.inside && (h.distance - exit).abs() < tol_t,
+                "{} {h:?} vs {exit}",
+                shape.kind_name()
+            );
+            assert!(h.normal.dot(dir) >= -1e-4);
+        }
+    }
+}
+
+#[test]
+fn gjk_raycast_agrees_with_hull_clipping_and_poses_are_applied() {
+    let mut rng = Rng(12);
+    let tol_t = if std::mem::size_of::<Real>() == 8 {
+        1e-9
+    } else {
+        1e-4
+    };
+    let mut hits = 0;
+    for _ in 0..300 {
+        let h = random_hull(&mut rng, 16, 1.0);
+        let origin = rng.unit() * 3.0;
+        let ray = Ray::new(origin, rng.vec(0.8) - origin).unwrap();
+        let g = raycast_convex_gjk(
+            carom_collision::shape::ConvexRef::ConvexHull(&h),
+            &ray,
+            10.0,
+            true,
+        );
+        let a = ray_hull(ray.origin, ray.dir, &h).filter(|i| i.t0 >= 0.0 && i.t0 <= 10.0);
+        match (g, a) {
+            (Some(g), Some(a)) => {
+                hits += 1;
+                assert!(
+                    (g.distance - a.t0).abs() < tol_t,
+                    "{} vs {}",
+                    g.distance,
+                    a.t0
+                );
+                assert!((g.normal - a.n0).length() < 1e-2 || g.normal.dot(a.n0) > 0.99);
+            }
+            (None, None) => {}
+            (g, a) => panic!("{g:?} vs {a:?}"),
+        }
+    }
+    assert!(hits > 100);
+    // Posed shape: the same as the local cast moved.
+    let b = Shape::Cuboid(Cuboid::new(Vec3::splat(0.5)).unwrap());
+    let pose = rng.pose(2.0);
+    let h = raycast(
+        &b,
+        &pose,
+        pose.translation + Vec3::X * 5.0,
+        -Vec3::X,
+        10.0,
+        true,
+    )
+    .unwrap()
+    .unwrap();
+    let local = pose.inverse_transform_point(h.point);
+    assert!(((local.abs() - Vec3::splat(0.5)).max_element()).abs() < 1e-4);
+}
+
+#[test]
+fn planes_triangles_meshes_and_bad_rays() {
+    let plane = Shape::Plane(Plane::new(Vec3::Y, 1.0).unwrap());
+    let h = raycast(
+        &plane,
+        &Isometry::IDENTITY,
+        Vec3::new(0.0, 5.0, 0.0),
+        -Vec3::Y,
+        100.0,
+        true,
+    )
+    .unwrap()
+    .unwrap();
+    assert!((h.distance - 4.0).abs() < 1e-5 && (h.normal - Vec3::Y).length() < 1e-6);
+    assert!(raycast(
+        &plane,
+        &Isometry::IDENTITY,
+        Vec3::new(0.0, 5.0, 0.0),
+        Vec3::Y,
+        100.0,
+        true
+    )
+    .unwrap()
+    .is_none());
+    let tri = Shape::Triangle(Triangle::new(Vec3::ZERO, Vec3::X, Vec3::Z).unwrap());
+    let h = raycast(
+        &tri,
+        &Isometry::IDENTITY,
+        Vec3::new(0.2, -1.0, 0.2),
+        Vec3::Y,
+        10.0,
+        true,
+    )
+    .unwrap()
+    .unwrap();
+    assert!((h.distance - 1.0).abs() < 1e-5 && h.normal.y < 0.0);
+    let mesh = Shape::TriMesh(
+        carom_collision::shape::TriMesh::new(
+            vec![Vec3::ZERO, Vec3::X, Vec3::Z, Vec3::new(1.0, 0.0, 1.0)],
+            vec![[0, 2, 1], [1, 2, 3]],
+        )
+        .unwrap(),
+    );
+    let h = raycast(
+        &mesh,
+        &Isometry::IDENTITY,
+        Vec3::new(0.8, 1.0, 0.8),
+        -Vec3::Y,
+        10.0,
+        true,
+    )
+    .unwrap()
+    .unwrap();
+    assert_eq!(h.feature, Some(1));
+    assert!((h.distance - 1.0).abs() < 1e-5);
+    let s = Shape::Sphere(Sphere::new(1.0).unwrap());
+    assert!(raycast(&s, &Isometry::IDENTITY, Vec3::ZERO, Vec3::ZERO, 1.0, true).is_err());
+    assert!(raycast(
+        &s,
+        &Isometry::IDENTITY,
+        Vec3::splat(Real::NAN),
+        Vec3::X,
+        1.0,
+        true
+    )
+    .is_err());
+    assert!(raycast(&s, &Isometry::IDENTITY, Vec3::ZERO, Vec3::X, -1.0, true).is_err());
+}
+
+#[test]
+fn point_projection_matches_oracles() {
+    let mut rng = Rng(13);
+    for shape in shapes(&mut rng) {
+        let mut ins = 0;
+        for _ in 0..150 {
+            let p = rng.vec(1.0);
+            let pr = project_point(&shape, &Isometry::IDENTITY, p).unwrap();
+            assert_eq!(
+                pr.inside,
+                inside(&shape, p),
+                "{} {p} {pr:?}",
+                shape.kind_name()
+            );
+            ins += pr.inside as i32;
+            assert!(
+                ((pr.point - p).length() - pr.distance.abs()).abs() < 1e-4,
+                "{} {pr:?}",
+                shape.kind_name()
+            );
+            // The projection is on the boundary.
+            let n = (p - pr.point).normalize_or_zero() * if pr.inside { -1.0 } else { 1.0 };
+            if n != Vec3::ZERO {
+                // Towards the centre (an interior point of every test shape) is inside.
+                assert!(
+                    inside(&shape, pr.point * (1.0 - 1e-3)),
+                    "{} {p} {pr:?}",
+                    shape.kind_name()
+                );
+                assert!(
+                    !inside(&shape, pr.point + n * 1e-3),
+                    "{} {p} {pr:?}",
+                    shape.kind_name()
+                );
+            }
+            // Closed forms agree with GJK/EPA.
+            if let Some(c) = shape.as_convex() {
+                let g = project_convex_gjk(c, p);
+                let loose = if pr.inside { 1e-3 } else { 1e-4 };
+                assert!(
+                    (g.distance - pr.distance).abs() < loose,
+                    "{} {p} {g:?} {pr:?}",
+                    shape.kind_name()
+                );
+            }
+        }
+        assert!(ins > 3, "{}: {ins}", shape.kind_name());
+    }
+}
+
+#[test]
+fn hull_point_distance_matches_triangle_enumeration() {
+    let mut rng = Rng(14);
+    let h = random_hull(&mut rng, 40, 1.0);
+    let shape = Shape::ConvexHull(h.clone());
+    let (tris, _) = hull_world(&h, &Isometry::IDENTITY);
+    for _ in 0..300 {
+        let p = rng.vec(1.6);
+        let pr = project_point(&shape, &Isometry::IDENTITY, p).unwrap();
+        let want = tris
+            .iter()
+            .map(|t| {
+                (carom_collision::query::closest_points::closest_point_triangle(
+                    p, t[0], t[1], t[2],
+                ) - p)
+                    .length()
+            })
+            .fold(Real::INFINITY, Real::min);
+        assert!(
+            (pr.distance.abs() - want).abs() < tol() * 5.0,
+            "{pr:?} vs {want}"
+        );
+    }
+}
