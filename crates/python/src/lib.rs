@@ -10,7 +10,9 @@ mod batch;
 mod composite;
 mod convert;
 mod errors;
+mod mesh;
 mod pose;
+mod queries;
 mod serialize;
 mod shape;
 mod shapes;
@@ -38,7 +40,10 @@ fn _carom(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<shapes::PyPlane>()?;
     m.add_class::<composite::PyConvexHull>()?;
     m.add_class::<composite::PyTriMesh>()?;
+    m.add_class::<composite::PyHeightField>()?;
     m.add_class::<composite::PyCompound>()?;
     m.add_class::<composite::PyScaled>()?;
+    m.add_class::<mesh::PyMeshRayHits>()?;
+    queries::register(m)?;
     Ok(())
 }
