@@ -180,3 +180,61 @@ def test_mesh_bad_input() -> None:
         mesh.closest_points("points")
     with pytest.raises(carom.CaromError, match="aabb_min"):
         mesh.overlapping_triangles([1, 1, 1], [0, 0, 0])
+
+
+def heightfield_triangles(heights: np.ndarray, dx: float, dz: float) -> np.ndarray:
+    """The triangles of a heightfield, numbered as documented on carom.HeightField."""
+    rows, cols = heights.shape
+
+    def p(r: int, c: int) -> np.ndarray:
+        return np.array([c * dx - (cols - 1) * dx / 2, heights[r, c], r * dz - (rows - 1) * dz / 2])
+
+    out = []
+    for r in range(rows - 1):
+        for c in range(cols - 1):
+            out.append([p(r, c), p(r + 1, c), p(r, c + 1)])
+            out.append([p(r, c + 1), p(r + 1, c), p(r + 1, c + 1)])
+    return np.array(out)
+
+
+def test_heightfield_raycast_and_overlap_against_brute_force() -> None:
+    rng = np.random.default_rng(8)
+    heights = rng.uniform(-0.3, 0.3, (6, 7))
+    hf = carom.HeightField(heights, cell_size=(0.4, 0.5))
+    tri = heightfield_triangles(heights, 0.4, 0.5)
+    n = 150
+    origins = rng.uniform(-2, 2, (n, 3))
+    origins[:, 1] = rng.uniform(1.0, 2.0, n)
+    targets = rng.uniform(-2, 2, (n, 3))
+    targets[:, 1] = 0.0
+    dirs = targets - origins
+    dirs /= np.linalg.norm(dirs, axis=1, keepdims=True)
+    res = hf.raycast(origins, dirs)
+    hits = 0
+    for i in range(n):
+        t = moller_trumbore(origins[i], dirs[i], tri)
+        if not np.isfinite(t.min()):
+            assert not res.hit[i]
+            continue
+        hits += 1
+        assert res.hit[i] and res.distance[i] == pytest.approx(t.min(), abs=20 * TOL)
+        assert t[res.triangle[i]] == pytest.approx(t.min(), abs=20 * TOL)
+    assert 0.2 * n <= hits <= 0.8 * n
+    lo_t, hi_t = tri.min(axis=1), tri.max(axis=1)
+    for _ in range(10):
+        c, h = rng.uniform(-1.5, 1.5, 3), rng.uniform(0.05, 0.6, 3)
+        c[1] = 0.0
+        got = hf.overlapping_triangles(c - h, c + h)
+        expected = np.nonzero(((lo_t <= c + h) & (hi_t >= c - h)).all(axis=1))[0]
+        np.testing.assert_array_equal(got, expected)
+
+
+def test_compound_overlapping_children_against_brute_force() -> None:
+    rng = np.random.default_rng(9)
+    centers = rng.uniform(-3, 3, (20, 3))
+    comp = carom.Compound([(carom.Sphere(0.3), [*c, 0, 0, 0, 1]) for c in centers])
+    for _ in range(20):
+        c, h = rng.uniform(-3, 3, 3), rng.uniform(0.1, 1.5, 3)
+        got = comp.overlapping_children(c - h, c + h)
+        expected = np.nonzero(((centers - 0.3 <= c + h) & (centers + 0.3 >= c - h)).all(axis=1))[0]
+        np.testing.assert_array_equal(got, expected)

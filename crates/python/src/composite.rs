@@ -189,7 +189,7 @@ impl PyTriMesh {
         let Shape::TriMesh(m) = shape_of(slf) else {
             return Err(wrong_kind("TriMesh"));
         };
-        crate::mesh::overlapping_triangles(slf.py(), m, aabb_min, aabb_max)
+        crate::mesh::overlapping(slf.py(), aabb_min, aabb_max, |b| m.overlapping_triangles(b))
     }
 
     /// Number of triangles.
@@ -266,6 +266,36 @@ impl PyHeightField {
         Ok((f64::from(dx), f64::from(dz)))
     }
 
+    /// Closest hits of rays in the heightfield's own frame (a 2D walk over the cells the ray
+    /// crosses): same arguments and `MeshRayHits` result as `TriMesh.raycast`, with the
+    /// triangle numbering of the class docstring.
+    #[pyo3(signature = (origins, directions, max_distance = f64::INFINITY))]
+    fn raycast(
+        slf: &Bound<'_, Self>,
+        origins: &Bound<'_, PyAny>,
+        directions: &Bound<'_, PyAny>,
+        max_distance: f64,
+    ) -> PyResult<crate::mesh::PyMeshRayHits> {
+        let Shape::HeightField(h) = shape_of(slf) else {
+            return Err(wrong_kind("HeightField"));
+        };
+        let md = scalar("max_distance", max_distance)?;
+        crate::mesh::raycast_heightfield(slf.py(), h, origins, directions, md)
+    }
+
+    /// Indices (ascending int64) of the triangles whose bounding boxes overlap the box
+    /// `[aabb_min, aabb_max]` (heightfield frame).
+    fn overlapping_triangles<'py>(
+        slf: &Bound<'py, Self>,
+        aabb_min: &Bound<'py, PyAny>,
+        aabb_max: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyArray1<i64>>> {
+        let Shape::HeightField(h) = shape_of(slf) else {
+            return Err(wrong_kind("HeightField"));
+        };
+        crate::mesh::overlapping(slf.py(), aabb_min, aabb_max, |b| h.triangles_in_aabb(b))
+    }
+
     /// Number of triangles, `2 (rows - 1) (cols - 1)`.
     #[getter]
     fn num_triangles(slf: &Bound<'_, Self>) -> PyResult<usize> {
@@ -330,6 +360,19 @@ impl PyCompound {
             parts.push(child(i, &item?)?);
         }
         Ok(init(core(|| Compound::new(parts))?.into(), PyCompound))
+    }
+
+    /// Indices (ascending int64) of the children whose bounding boxes overlap the box
+    /// `[aabb_min, aabb_max]` (compound frame), found with the children's BVH.
+    fn overlapping_children<'py>(
+        slf: &Bound<'py, Self>,
+        aabb_min: &Bound<'py, PyAny>,
+        aabb_max: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyArray1<i64>>> {
+        let Shape::Compound(c) = shape_of(slf) else {
+            return Err(wrong_kind("Compound"));
+        };
+        crate::mesh::overlapping(slf.py(), aabb_min, aabb_max, |b| c.children_in_aabb(b))
     }
 
     /// The children as a list of `(shape, Pose)` pairs (poses at the core's precision,

@@ -1,11 +1,13 @@
 //! Triangle-mesh queries in the mesh's own frame (`TriMesh.raycast`, `closest_points`,
-//! `overlapping_triangles`), thin wrappers of the core's BVH queries
+//! `overlapping_triangles`, and the same on heightfields and compounds), thin wrappers of the core's BVH queries
 //! (`carom_collision::shape::TriMesh`); batches release the GIL and run in parallel.
 
+use crate::batch;
 use crate::convert::{indices_out, require_finite, vec3, vec3s, vec3s_out};
-use crate::errors::{guard, invalid};
+use crate::errors::{carom_err, guard, invalid};
 use carom_collision::math::{vec3_to_f64, Aabb, Real, Vec3};
-use carom_collision::shape::TriMesh;
+use carom_collision::midphase::MeshRayHit;
+use carom_collision::shape::{HeightField, TriMesh};
 use numpy::{PyArray1, PyArray2};
 use pyo3::prelude::*;
 use pyo3::types::PyTuple;
@@ -60,7 +62,33 @@ fn rays(
     Ok((o, unit))
 }
 
-/// `mesh.raycast(origins, directions, max_distance)`.
+fn check_max_distance(max_distance: Real) -> PyResult<()> {
+    if max_distance.is_nan() || max_distance < 0.0 {
+        return Err(invalid(format!(
+            "invalid max_distance = {max_distance:?}: must be >= 0"
+        )));
+    }
+    Ok(())
+}
+
+/// Batch ray casts with `cast(origin, unit_direction, max_distance)` per ray (GIL released,
+/// parallel above `batch::PARALLEL_MIN`), as a `MeshRayHits`.
+pub fn raycast_with(
+    py: Python<'_>,
+    origins: &Bound<'_, PyAny>,
+    directions: &Bound<'_, PyAny>,
+    max_distance: Real,
+    cast: impl Fn(&[Vec3], &[Vec3], Real) -> carom_collision::Result<Vec<Option<MeshRayHit>>>
+        + Send
+        + Sync,
+) -> PyResult<PyMeshRayHits> {
+    check_max_distance(max_distance)?;
+    let (o, d) = rays(origins, directions)?;
+    let hits = py.detach(|| guard(|| cast(&o, &d, max_distance).map_err(carom_err)))?;
+    Ok(hits_out(py, &hits))
+}
+
+/// `mesh.raycast(origins, directions, max_distance)`, by the core's `TriMesh::raycast_batch`.
 pub fn raycast(
     py: Python<'_>,
     mesh: &TriMesh,
@@ -68,22 +96,30 @@ pub fn raycast(
     directions: &Bound<'_, PyAny>,
     max_distance: Real,
 ) -> PyResult<PyMeshRayHits> {
-    if max_distance.is_nan() || max_distance < 0.0 {
-        return Err(invalid(format!(
-            "invalid max_distance = {max_distance:?}: must be >= 0"
-        )));
-    }
-    let (o, d) = rays(origins, directions)?;
-    let hits = py.detach(|| {
-        guard(|| {
-            mesh.raycast_batch(&o, &d, max_distance)
-                .map_err(crate::errors::carom_err)
-        })
-    })?;
+    raycast_with(py, origins, directions, max_distance, |o, d, t| {
+        mesh.raycast_batch(o, d, t)
+    })
+}
+
+/// `heightfield.raycast(origins, directions, max_distance)`, by `HeightField::raycast`.
+pub fn raycast_heightfield(
+    py: Python<'_>,
+    hf: &HeightField,
+    origins: &Bound<'_, PyAny>,
+    directions: &Bound<'_, PyAny>,
+    max_distance: Real,
+) -> PyResult<PyMeshRayHits> {
+    raycast_with(py, origins, directions, max_distance, |o, d, t| {
+        let pairs: Vec<(Vec3, Vec3)> = o.iter().copied().zip(d.iter().copied()).collect();
+        Ok(batch::map(&pairs, |(o, d)| hf.raycast(*o, *d, t)))
+    })
+}
+
+fn hits_out(py: Python<'_>, hits: &[Option<MeshRayHit>]) -> PyMeshRayHits {
     let nan = Vec3::splat(Real::NAN);
     let points: Vec<Vec3> = hits.iter().map(|h| h.map_or(nan, |h| h.point)).collect();
     let normals: Vec<Vec3> = hits.iter().map(|h| h.map_or(nan, |h| h.normal)).collect();
-    Ok(PyMeshRayHits {
+    PyMeshRayHits {
         hit: PyArray1::from_vec(py, hits.iter().map(Option::is_some).collect()).unbind(),
         distance: PyArray1::from_vec(
             py,
@@ -101,7 +137,7 @@ pub fn raycast(
                 .collect(),
         )
         .unbind(),
-    })
+    }
 }
 
 /// `mesh.closest_points(points, max_distance)`: `(points (N, 3), distances (N,),
@@ -112,11 +148,7 @@ pub fn closest_points<'py>(
     points: &Bound<'py, PyAny>,
     max_distance: Real,
 ) -> PyResult<Bound<'py, PyTuple>> {
-    if max_distance.is_nan() || max_distance < 0.0 {
-        return Err(invalid(format!(
-            "invalid max_distance = {max_distance:?}: must be >= 0"
-        )));
-    }
+    check_max_distance(max_distance)?;
     let (pts, _) = vec3s(points, "points", true)?;
     require_finite("points", &pts)?;
     let res = py.detach(|| guard(|| Ok(mesh.closest_point_batch(&pts, max_distance))))?;
@@ -140,13 +172,8 @@ pub fn closest_points<'py>(
     )
 }
 
-/// `mesh.overlapping_triangles(aabb_min, aabb_max)`: ascending int64 indices.
-pub fn overlapping_triangles<'py>(
-    py: Python<'py>,
-    mesh: &TriMesh,
-    aabb_min: &Bound<'py, PyAny>,
-    aabb_max: &Bound<'py, PyAny>,
-) -> PyResult<Bound<'py, PyArray1<i64>>> {
+/// The box `[aabb_min, aabb_max]` (finite, `aabb_min <= aabb_max`).
+pub fn aabb_arg(aabb_min: &Bound<'_, PyAny>, aabb_max: &Bound<'_, PyAny>) -> PyResult<Aabb> {
     let lo = vec3(aabb_min, "aabb_min")?;
     let hi = vec3(aabb_max, "aabb_max")?;
     require_finite("aabb_min", &[lo])?;
@@ -154,7 +181,18 @@ pub fn overlapping_triangles<'py>(
     if !lo.cmple(hi).all() {
         return Err(invalid("aabb_min must be <= aabb_max in every component"));
     }
-    let aabb = Aabb::new(lo, hi);
-    let tris = guard(|| Ok(mesh.overlapping_triangles(&aabb)))?;
-    Ok(indices_out(py, &tris))
+    Ok(Aabb::new(lo, hi))
+}
+
+/// Ascending int64 indices of the items (triangles, children) whose boxes overlap the box
+/// `[aabb_min, aabb_max]`, by `query`.
+pub fn overlapping<'py>(
+    py: Python<'py>,
+    aabb_min: &Bound<'py, PyAny>,
+    aabb_max: &Bound<'py, PyAny>,
+    query: impl FnOnce(&Aabb) -> Vec<u32>,
+) -> PyResult<Bound<'py, PyArray1<i64>>> {
+    let aabb = aabb_arg(aabb_min, aabb_max)?;
+    let items = guard(|| Ok(query(&aabb)))?;
+    Ok(indices_out(py, &items))
 }
