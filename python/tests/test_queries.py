@@ -246,3 +246,22 @@ def test_heightfield() -> None:
         carom.HeightField(np.zeros((1, 4)))
     with pytest.raises(carom.CaromError, match=r"heights"):
         carom.HeightField([[0, 1], [np.nan, 0]])
+
+
+def test_shape_cast_batch_equals_single() -> None:
+    rng = np.random.default_rng(8)
+    a, b = carom.Sphere(0.4), carom.Box([0.3, 0.5, 0.2])
+    poses_b = np.tile(pose([0, 0, 0]), (30, 1))
+    poses_b[:, :3] = rng.uniform(-3, 3, (30, 3))
+    vel_a = poses_b[:, :3] * 1.5 + rng.uniform(-1, 1, (30, 3))
+    batch = carom.shape_cast(a, pose([0, 0, 0]), vel_a, b, poses_b, [0, 0, 0])
+    assert batch is not None and batch.toi.shape == (30,)
+    n_hit = 0
+    for i in range(30):
+        one = carom.shape_cast(a, pose([0, 0, 0]), vel_a[i], b, poses_b[i], [0, 0, 0])
+        assert (one is None) == bool(np.isnan(batch.toi[i]))
+        if one is not None:
+            n_hit += 1
+            assert batch.toi[i] == one.toi
+            np.testing.assert_array_equal(batch.normal[i], one.normal)
+    assert n_hit > 0

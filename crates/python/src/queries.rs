@@ -194,7 +194,7 @@ impl PyPointProjection {
 
 /// Result of a shape cast or time of impact: `toi` (fraction of the motion), world witness
 /// points `point_a`, `point_b` and `normal` (unit, A towards B) at that time, and
-/// `initially_overlapping`.
+/// `initially_overlapping`. Arrays for batches.
 #[pyclass(name = "ShapeCastHit", module = "carom", frozen, get_all)]
 pub struct PyShapeCastHit {
     /// Time of impact as a fraction of the motion.
@@ -217,6 +217,20 @@ impl PyShapeCastHit {
             point_b: v(py, h.point_b),
             normal: v(py, h.normal),
             initially_overlapping: b(py, h.initially_overlapping),
+        }
+    }
+
+    fn many(py: Python<'_>, hs: &[Option<ShapeCastHit>]) -> Self {
+        PyShapeCastHit {
+            toi: fs(py, hs.iter().map(|h| h.map_or(Real::NAN, |h| h.toi))),
+            point_a: vs(py, hs.iter().map(|h| h.map_or(NAN3, |h| h.point_a))),
+            point_b: vs(py, hs.iter().map(|h| h.map_or(NAN3, |h| h.point_b))),
+            normal: vs(py, hs.iter().map(|h| h.map_or(NAN3, |h| h.normal))),
+            initially_overlapping: bs(
+                py,
+                hs.iter()
+                    .map(|h| h.is_some_and(|h| h.initially_overlapping)),
+            ),
         }
     }
 }
@@ -372,7 +386,9 @@ pub fn project_point(
 }
 
 /// Linear shape cast: `a` moves by `velocity_a` and `b` by `velocity_b` per unit time, from
-/// the given poses; the first time in `[0, max_time]` they touch, or `None`. Single poses.
+/// the given poses; the first time in `[0, max_time]` they touch, or `None`. With `(N, 7)`
+/// poses and/or `(N, 3)` velocities (the others broadcast), a `ShapeCastHit` of arrays (NaN
+/// `toi` for misses), GIL released.
 #[pyfunction]
 #[pyo3(signature = (a, pose_a, velocity_a, b, pose_b, velocity_b, max_time = 1.0))]
 #[allow(clippy::too_many_arguments)]
@@ -387,15 +403,17 @@ pub fn shape_cast(
     max_time: f64,
 ) -> PyResult<Option<PyShapeCastHit>> {
     let (sa, sb) = (shape_arg(a, "a")?, shape_arg(b, "b")?);
-    let pa = crate::pose::extract_isometry(Some(pose_a), "pose_a")?;
-    let pb = crate::pose::extract_isometry(Some(pose_b), "pose_b")?;
-    let (va, vb) = (
-        vec3(velocity_a, "velocity_a")?,
-        vec3(velocity_b, "velocity_b")?,
-    );
+    let (pa, pb, single_poses) = pose_pair(pose_a, pose_b)?;
+    let (va, sva) = vec3s(velocity_a, "velocity_a", true)?;
+    let (vb, svb) = vec3s(velocity_b, "velocity_b", true)?;
     let t = scalar("max_time", max_time)?;
-    let h = core(|| query::shape_cast(&sa, &pa, va, &sb, &pb, vb, t))?;
-    Ok(h.map(|h| PyShapeCastHit::one(py, &h)))
+    if single_poses && sva && svb {
+        let h = core(|| query::shape_cast(&sa, &pa[0], va[0], &sb, &pb[0], vb[0], t))?;
+        return Ok(h.map(|h| PyShapeCastHit::one(py, &h)));
+    }
+    let hs =
+        py.detach(move || core(|| query::shape_cast_batch(&sa, &pa, &va, &sb, &pb, &vb, t)))?;
+    Ok(Some(PyShapeCastHit::many(py, &hs)))
 }
 
 /// Time of impact with rotation: each shape moves from its pose with a linear and an angular
