@@ -1,10 +1,16 @@
 """Carom: collision detection and rigid-body physics with a Rust core.
 
 Shapes (``Sphere``, ``Box``, ``Capsule``, ``Cylinder``, ``Cone``, ``ConvexHull``,
-``Triangle``, ``TriMesh``, ``Compound``, ``Plane`` and ``shape.scaled(...)``) and poses
+``Triangle``, ``TriMesh``, ``HeightField``, ``Compound``, ``Plane`` and
+``shape.scaled(...)``) and poses
 (``Pose``, a position and a unit quaternion ``(x, y, z, w)`` as in pybullet). Arrays go in
 and come out as float64 numpy arrays; anything ``numpy.asarray`` turns into numbers is
 accepted. Capsules, cylinders and cones lie along the local **Y** axis.
+
+Queries (``distance``, ``contact``, ``intersects``, ``raycast``, ``project_point``,
+``shape_cast``, ``time_of_impact``) use a signed distance (negative = penetration) and a
+normal from A towards B, so ``point_b = point_a + normal * distance``; given ``(N, 7)`` poses
+or ``(N, 3)`` rays/points they return results whose fields are arrays of length N.
 
 Invalid values raise :class:`CaromError` (a ``ValueError``) naming the bad value; wrong
 types raise ``TypeError``.
@@ -34,6 +40,19 @@ from carom._carom import (
     Sphere,
     Triangle,
     TriMesh,
+    Contact,
+    HeightField,
+    MeshRayHits,
+    PointProjection,
+    RayHit,
+    ShapeCastHit,
+    contact,
+    distance,
+    intersects,
+    project_point,
+    raycast,
+    shape_cast,
+    time_of_impact,
     __version__,
 )
 
@@ -53,5 +72,18 @@ __all__ = [
     "Sphere",
     "Triangle",
     "TriMesh",
+    "Contact",
+    "HeightField",
+    "MeshRayHits",
+    "PointProjection",
+    "RayHit",
+    "ShapeCastHit",
+    "contact",
+    "distance",
+    "intersects",
+    "project_point",
+    "raycast",
+    "shape_cast",
+    "time_of_impact",
     "__version__",
 ]

@@ -1,5 +1,6 @@
 """Type stubs of the extension module ``carom._carom`` (re-exported by ``carom``)."""
 
+import os
 from typing import Any, Optional, Sequence, Tuple, Union
 
 import numpy as np
@@ -18,16 +19,29 @@ __all__ = [
     "CaromError",
     "Compound",
     "Cone",
+    "Contact",
     "ConvexHull",
     "Cylinder",
+    "HeightField",
+    "MeshRayHits",
     "Plane",
+    "PointProjection",
     "Pose",
     "REAL_BITS",
+    "RayHit",
     "Scaled",
     "Shape",
+    "ShapeCastHit",
     "Sphere",
     "TriMesh",
     "Triangle",
+    "contact",
+    "distance",
+    "intersects",
+    "project_point",
+    "raycast",
+    "shape_cast",
+    "time_of_impact",
     "__version__",
 ]
 
@@ -159,6 +173,37 @@ class TriMesh(Shape):
     def vertices(self) -> _F64: ...
     @property
     def indices(self) -> _I64: ...
+    @property
+    def num_triangles(self) -> int: ...
+    @staticmethod
+    def load(path: Union[str, "os.PathLike[str]"]) -> TriMesh: ...
+    @staticmethod
+    def from_obj_bytes(data: bytes) -> TriMesh: ...
+    @staticmethod
+    def from_stl_bytes(data: bytes) -> TriMesh: ...
+    def raycast(
+        self, origins: _ArrayLike, directions: _ArrayLike, max_distance: float = ...
+    ) -> MeshRayHits: ...
+    def closest_points(
+        self, points: _ArrayLike, max_distance: float = ...
+    ) -> Tuple[_F64, _F64, _I64]: ...
+    def overlapping_triangles(self, aabb_min: _ArrayLike, aabb_max: _ArrayLike) -> _I64: ...
+
+@final
+class HeightField(Shape):
+    def __new__(
+        cls, heights: _ArrayLike, cell_size: Tuple[float, float] = ...
+    ) -> HeightField: ...
+    @property
+    def heights(self) -> _F64: ...
+    @property
+    def cell_size(self) -> Tuple[float, float]: ...
+    @property
+    def num_triangles(self) -> int: ...
+    def raycast(
+        self, origins: _ArrayLike, directions: _ArrayLike, max_distance: float = ...
+    ) -> MeshRayHits: ...
+    def overlapping_triangles(self, aabb_min: _ArrayLike, aabb_max: _ArrayLike) -> _I64: ...
 
 @final
 class Compound(Shape):
@@ -167,6 +212,7 @@ class Compound(Shape):
     ) -> Compound: ...
     @property
     def children(self) -> list[Tuple[Shape, Pose]]: ...
+    def overlapping_children(self, aabb_min: _ArrayLike, aabb_max: _ArrayLike) -> _I64: ...
 
 @final
 class Scaled(Shape):
@@ -175,3 +221,100 @@ class Scaled(Shape):
     def inner(self) -> Shape: ...
     @property
     def scale(self) -> _F64: ...
+
+@final
+class Contact:
+    @property
+    def distance(self) -> Any: ...
+    @property
+    def point_a(self) -> _F64: ...
+    @property
+    def point_b(self) -> _F64: ...
+    @property
+    def normal(self) -> _F64: ...
+
+@final
+class MeshRayHits:
+    @property
+    def hit(self) -> npt.NDArray[np.bool_]: ...
+    @property
+    def distance(self) -> _F64: ...
+    @property
+    def point(self) -> _F64: ...
+    @property
+    def normal(self) -> _F64: ...
+    @property
+    def triangle(self) -> _I64: ...
+
+@final
+class RayHit:
+    @property
+    def hit(self) -> Any: ...
+    @property
+    def distance(self) -> Any: ...
+    @property
+    def point(self) -> _F64: ...
+    @property
+    def normal(self) -> _F64: ...
+    @property
+    def inside(self) -> Any: ...
+    @property
+    def feature(self) -> Any: ...
+
+@final
+class PointProjection:
+    @property
+    def point(self) -> _F64: ...
+    @property
+    def distance(self) -> Any: ...
+    @property
+    def inside(self) -> Any: ...
+
+@final
+class ShapeCastHit:
+    @property
+    def toi(self) -> Any: ...
+    @property
+    def point_a(self) -> _F64: ...
+    @property
+    def point_b(self) -> _F64: ...
+    @property
+    def normal(self) -> _F64: ...
+    @property
+    def initially_overlapping(self) -> Any: ...
+
+def distance(a: Shape, pose_a: _PoseLike, b: Shape, pose_b: _PoseLike) -> Contact: ...
+def contact(
+    a: Shape, pose_a: _PoseLike, b: Shape, pose_b: _PoseLike, prediction: float = 0.0
+) -> Optional[Contact]: ...
+def intersects(a: Shape, pose_a: _PoseLike, b: Shape, pose_b: _PoseLike) -> Any: ...
+def raycast(
+    shape: Shape,
+    pose: _PoseLike,
+    origin: _ArrayLike,
+    direction: _ArrayLike,
+    max_distance: float = ...,
+    solid: bool = True,
+) -> Optional[RayHit]: ...
+def project_point(shape: Shape, pose: _PoseLike, point: _ArrayLike) -> PointProjection: ...
+def shape_cast(
+    a: Shape,
+    pose_a: _PoseLike,
+    velocity_a: _ArrayLike,
+    b: Shape,
+    pose_b: _PoseLike,
+    velocity_b: _ArrayLike,
+    max_time: float = 1.0,
+) -> Optional[ShapeCastHit]: ...
+def time_of_impact(
+    a: Shape,
+    pose_a: _PoseLike,
+    velocity_a: _ArrayLike,
+    angular_velocity_a: _ArrayLike,
+    b: Shape,
+    pose_b: _PoseLike,
+    velocity_b: _ArrayLike,
+    angular_velocity_b: _ArrayLike,
+    max_time: float = 1.0,
+    tolerance: float = 0.0001,
+) -> Optional[ShapeCastHit]: ...

@@ -3,16 +3,22 @@
 //!
 //! Each constructor is the one place its core constructor is called.
 
-use crate::convert::{index_triples, indices_out, triples_out, vec3_out, vec3s, vec3s_out};
-use crate::errors::{carom_err, core};
+use crate::convert::{
+    array_values, float_array, index_triples, indices_out, scalar, shape_str, to_real, triples_out,
+    vec3_out, vec3s, vec3s_out,
+};
+use crate::errors::{carom_err, core, invalid};
 use crate::pose::{extract_isometry, Pose64, PyPose};
 use crate::serialize::hull_problem;
 use crate::shape::{scale_factors, PyShape};
 use crate::shapes::{init, shape_of, wrap_shape, wrong_kind};
 use carom_collision::math::Isometry;
-use carom_collision::shape::{Compound, ConvexHull, Scaled, Shape, TriMesh};
+use carom_collision::shape::{
+    Compound, ConvexHull, HeightField, Scaled, Shape, TriMesh, TriMeshOptions,
+};
 use carom_collision::CaromError;
-use numpy::{PyArray1, PyArray2};
+use numpy::ndarray::Array2;
+use numpy::{IntoPyArray, PyArray1, PyArray2};
 use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
 use pyo3::types::{PyList, PyTuple};
@@ -115,6 +121,186 @@ impl PyTriMesh {
             _ => Err(wrong_kind("TriMesh")),
         }
     }
+
+    /// Loads a mesh from a `.obj` or `.stl` file (by extension, case-insensitive; OBJ
+    /// polygons are triangulated, STL duplicate vertices merged). Unreadable or malformed
+    /// files raise `CaromError`.
+    #[staticmethod]
+    fn load(py: Python<'_>, path: std::path::PathBuf) -> PyResult<Bound<'_, PyAny>> {
+        let mesh = py.detach(move || core(|| TriMesh::load(&path)))?;
+        wrap_shape(py, Arc::new(mesh.into()))
+    }
+
+    /// A mesh from the bytes of an OBJ file (default options).
+    #[staticmethod]
+    fn from_obj_bytes<'py>(py: Python<'py>, data: &[u8]) -> PyResult<Bound<'py, PyAny>> {
+        let mesh = core(|| TriMesh::from_obj_bytes(data, TriMeshOptions::default()))?;
+        wrap_shape(py, Arc::new(mesh.into()))
+    }
+
+    /// A mesh from the bytes of an STL file, ASCII or binary (default options).
+    #[staticmethod]
+    fn from_stl_bytes<'py>(py: Python<'py>, data: &[u8]) -> PyResult<Bound<'py, PyAny>> {
+        let mesh = core(|| TriMesh::from_stl_bytes(data, TriMeshOptions::default()))?;
+        wrap_shape(py, Arc::new(mesh.into()))
+    }
+
+    /// Closest hits of rays in the mesh's own frame: `origins` and `directions` `(N, 3)`
+    /// (finite; directions non-zero, normalised here), up to `max_distance` (>= 0). Returns
+    /// a `MeshRayHits` (`hit`, `distance`, `point`, `normal`, `triangle`, arrays of length
+    /// N). Uses the BVH, releases the GIL and runs in parallel.
+    #[pyo3(signature = (origins, directions, max_distance = f64::INFINITY))]
+    fn raycast(
+        slf: &Bound<'_, Self>,
+        origins: &Bound<'_, PyAny>,
+        directions: &Bound<'_, PyAny>,
+        max_distance: f64,
+    ) -> PyResult<crate::mesh::PyMeshRayHits> {
+        let Shape::TriMesh(m) = shape_of(slf) else {
+            return Err(wrong_kind("TriMesh"));
+        };
+        let md = scalar("max_distance", max_distance)?;
+        crate::mesh::raycast(slf.py(), m, origins, directions, md)
+    }
+
+    /// Closest points of the mesh (its surface, in its own frame) to `points` `(N, 3)`
+    /// within `max_distance`: `(points (N, 3), distances (N,), triangles (N,) int64)`, NaN
+    /// and -1 where no triangle is within `max_distance`. Releases the GIL.
+    #[pyo3(signature = (points, max_distance = f64::INFINITY))]
+    fn closest_points<'py>(
+        slf: &Bound<'py, Self>,
+        points: &Bound<'py, PyAny>,
+        max_distance: f64,
+    ) -> PyResult<Bound<'py, PyTuple>> {
+        let Shape::TriMesh(m) = shape_of(slf) else {
+            return Err(wrong_kind("TriMesh"));
+        };
+        let md = scalar("max_distance", max_distance)?;
+        crate::mesh::closest_points(slf.py(), m, points, md)
+    }
+
+    /// Indices (ascending int64) of the triangles whose bounding boxes overlap the box
+    /// `[aabb_min, aabb_max]` (mesh frame).
+    fn overlapping_triangles<'py>(
+        slf: &Bound<'py, Self>,
+        aabb_min: &Bound<'py, PyAny>,
+        aabb_max: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyArray1<i64>>> {
+        let Shape::TriMesh(m) = shape_of(slf) else {
+            return Err(wrong_kind("TriMesh"));
+        };
+        crate::mesh::overlapping(slf.py(), aabb_min, aabb_max, |b| m.overlapping_triangles(b))
+    }
+
+    /// Number of triangles.
+    #[getter]
+    fn num_triangles(slf: &Bound<'_, Self>) -> PyResult<usize> {
+        match shape_of(slf) {
+            Shape::TriMesh(m) => Ok(m.num_triangles()),
+            _ => Err(wrong_kind("TriMesh")),
+        }
+    }
+}
+
+/// A heightfield over the local XZ plane, Y up, for static bodies: `heights` `(rows, cols)`
+/// (finite, each at least 2), sample `(r, c)` at
+/// `(c dx - (cols - 1) dx / 2, heights[r, c], r dz - (rows - 1) dz / 2)` (rows along Z,
+/// columns along X, centred on the origin in X and Z), `cell_size` `(dx, dz)` finite and > 0.
+/// Cell `(r, c)` holds triangles `2 (r (cols - 1) + c)` and `+ 1`, facing +Y. Not convex, no
+/// volume or mass.
+#[pyclass(name = "HeightField", module = "carom", extends = PyShape, frozen)]
+pub struct PyHeightField;
+
+fn heightfield_of(slf: &Bound<'_, PyHeightField>) -> PyResult<HeightField> {
+    match shape_of(slf) {
+        Shape::HeightField(h) => Ok(h.clone()),
+        _ => Err(wrong_kind("HeightField")),
+    }
+}
+
+#[pymethods]
+impl PyHeightField {
+    #[new]
+    #[pyo3(signature = (heights, cell_size = (1.0, 1.0)))]
+    fn new(
+        heights: &Bound<'_, PyAny>,
+        cell_size: (f64, f64),
+    ) -> PyResult<PyClassInitializer<Self>> {
+        let (shape, values) = array_values(&float_array(heights, "heights")?)?;
+        let [rows, cols] = shape.as_slice() else {
+            return Err(invalid(format!(
+                "heights must have shape (rows, cols), got {}",
+                shape_str(&shape)
+            )));
+        };
+        let (rows, cols) = (*rows, *cols);
+        let hs = values
+            .iter()
+            .enumerate()
+            .map(|(i, &h)| to_real(&|| format!("heights[{}, {}]", i / cols, i % cols), h))
+            .collect::<PyResult<Vec<_>>>()?;
+        let dx = scalar("cell_size[0]", cell_size.0)?;
+        let dz = scalar("cell_size[1]", cell_size.1)?;
+        Ok(init(
+            core(|| HeightField::new(rows, cols, hs, dx, dz))?.into(),
+            PyHeightField,
+        ))
+    }
+
+    /// The heights, `(rows, cols)` (rows along Z, columns along X).
+    #[getter]
+    fn heights<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let h = heightfield_of(slf)?;
+        let (rows, cols) = (h.rows(), h.cols());
+        let hs = h.heights();
+        Ok(
+            Array2::from_shape_fn((rows, cols), |(r, c)| f64::from(hs[r * cols + c]))
+                .into_pyarray(slf.py()),
+        )
+    }
+
+    /// The cell sizes `(dx, dz)` along X and Z.
+    #[getter]
+    fn cell_size(slf: &Bound<'_, Self>) -> PyResult<(f64, f64)> {
+        let (dx, dz) = heightfield_of(slf)?.cell_size();
+        Ok((f64::from(dx), f64::from(dz)))
+    }
+
+    /// Closest hits of rays in the heightfield's own frame (a 2D walk over the cells the ray
+    /// crosses): same arguments and `MeshRayHits` result as `TriMesh.raycast`, with the
+    /// triangle numbering of the class docstring.
+    #[pyo3(signature = (origins, directions, max_distance = f64::INFINITY))]
+    fn raycast(
+        slf: &Bound<'_, Self>,
+        origins: &Bound<'_, PyAny>,
+        directions: &Bound<'_, PyAny>,
+        max_distance: f64,
+    ) -> PyResult<crate::mesh::PyMeshRayHits> {
+        let Shape::HeightField(h) = shape_of(slf) else {
+            return Err(wrong_kind("HeightField"));
+        };
+        let md = scalar("max_distance", max_distance)?;
+        crate::mesh::raycast_heightfield(slf.py(), h, origins, directions, md)
+    }
+
+    /// Indices (ascending int64) of the triangles whose bounding boxes overlap the box
+    /// `[aabb_min, aabb_max]` (heightfield frame).
+    fn overlapping_triangles<'py>(
+        slf: &Bound<'py, Self>,
+        aabb_min: &Bound<'py, PyAny>,
+        aabb_max: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyArray1<i64>>> {
+        let Shape::HeightField(h) = shape_of(slf) else {
+            return Err(wrong_kind("HeightField"));
+        };
+        crate::mesh::overlapping(slf.py(), aabb_min, aabb_max, |b| h.triangles_in_aabb(b))
+    }
+
+    /// Number of triangles, `2 (rows - 1) (cols - 1)`.
+    #[getter]
+    fn num_triangles(slf: &Bound<'_, Self>) -> PyResult<usize> {
+        Ok(heightfield_of(slf)?.num_triangles())
+    }
 }
 
 /// A rigid assembly of child shapes: `children` is a non-empty sequence of
@@ -174,6 +360,19 @@ impl PyCompound {
             parts.push(child(i, &item?)?);
         }
         Ok(init(core(|| Compound::new(parts))?.into(), PyCompound))
+    }
+
+    /// Indices (ascending int64) of the children whose bounding boxes overlap the box
+    /// `[aabb_min, aabb_max]` (compound frame), found with the children's BVH.
+    fn overlapping_children<'py>(
+        slf: &Bound<'py, Self>,
+        aabb_min: &Bound<'py, PyAny>,
+        aabb_max: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyArray1<i64>>> {
+        let Shape::Compound(c) = shape_of(slf) else {
+            return Err(wrong_kind("Compound"));
+        };
+        crate::mesh::overlapping(slf.py(), aabb_min, aabb_max, |b| c.children_in_aabb(b))
     }
 
     /// The children as a list of `(shape, Pose)` pairs (poses at the core's precision,

@@ -93,10 +93,11 @@ pub fn to_real(name: &dyn Fn() -> String, x: f64) -> PyResult<Real> {
     Ok(r)
 }
 
-/// True unless converting the finite `x` to `r` over- or underflowed.
+/// True unless converting the finite `x` to `r` over- or underflowed (a subnormal result
+/// counts as underflow: it has lost precision).
 #[inline(always)]
 fn fits(x: f64, r: Real) -> bool {
-    !x.is_finite() || (r.is_finite() && (r != 0.0 || x == 0.0))
+    !x.is_finite() || x == 0.0 || r.is_normal()
 }
 
 /// A scalar [`Real`] argument.

@@ -6,11 +6,16 @@
 //! byte encoding for pickling (`serialize`) and parallel batches (`batch`). No Rust panic
 //! reaches the interpreter: every call into the core runs under `errors::guard`.
 
+// `f64::from(x)` with `x: Real` is a no-op in the f64 build by design (like `x as Real`).
+#![allow(clippy::useless_conversion)]
+
 mod batch;
 mod composite;
 mod convert;
 mod errors;
+mod mesh;
 mod pose;
+mod queries;
 mod serialize;
 mod shape;
 mod shapes;
@@ -38,7 +43,10 @@ fn _carom(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<shapes::PyPlane>()?;
     m.add_class::<composite::PyConvexHull>()?;
     m.add_class::<composite::PyTriMesh>()?;
+    m.add_class::<composite::PyHeightField>()?;
     m.add_class::<composite::PyCompound>()?;
     m.add_class::<composite::PyScaled>()?;
+    m.add_class::<mesh::PyMeshRayHits>()?;
+    queries::register(m)?;
     Ok(())
 }

@@ -9,8 +9,8 @@
 
 use carom_collision::math::check_isometry;
 use carom_collision::shape::{
-    Capsule, Compound, Cone, ConvexHull, Cuboid, Cylinder, Plane, Scaled, Shape, Sphere,
-    SupportMap, TriMesh, Triangle,
+    Capsule, Compound, Cone, ConvexHull, Cuboid, Cylinder, HeightField, Plane, Scaled, Shape,
+    Sphere, SupportMap, TriMesh, Triangle,
 };
 use carom_collision::{CaromError, Result};
 
@@ -97,6 +97,14 @@ fn validate(shape: &Shape, depth: usize) -> Result<()> {
             m,
             "triangle mesh",
         ),
+        Shape::HeightField(h) => {
+            let (dx, dz) = h.cell_size();
+            same(
+                HeightField::new(h.rows(), h.cols(), h.heights().to_vec(), dx, dz)?,
+                h,
+                "heightfield",
+            )
+        }
         Shape::Compound(c) => {
             for (pose, child) in c.children() {
                 check_isometry("child pose", *pose)?;

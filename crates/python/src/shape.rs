@@ -67,19 +67,21 @@ impl PyShape {
 #[pymethods]
 impl PyShape {
     /// The kind of shape: `"sphere"`, `"box"`, `"capsule"`, `"cylinder"`, `"cone"`,
-    /// `"convex_hull"`, `"triangle"`, `"plane"`, `"trimesh"`, `"compound"` or `"scaled"`.
+    /// `"convex_hull"`, `"triangle"`, `"plane"`, `"trimesh"`, `"heightfield"`, `"compound"` or
+    /// `"scaled"`.
     #[getter]
     fn kind(&self) -> &'static str {
         kind_str(&self.inner)
     }
 
-    /// True for shapes with a support map (all but planes, meshes and compounds).
+    /// True for shapes with a support map (all but planes, meshes, heightfields and compounds).
     #[getter]
     fn is_convex(&self) -> bool {
         self.inner.is_convex()
     }
 
-    /// Volume (0 for triangles, planes and open meshes; compounds sum their children).
+    /// Volume (0 for triangles, planes, heightfields and open meshes; compounds sum their
+    /// children).
     #[getter]
     fn volume(&self) -> PyResult<f64> {
         guard(|| Ok(f64::from(self.inner.volume())))

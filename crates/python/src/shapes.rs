@@ -3,7 +3,7 @@
 //!
 //! Each constructor is the one place its core constructor is called.
 
-use crate::composite::{PyCompound, PyConvexHull, PyScaled, PyTriMesh};
+use crate::composite::{PyCompound, PyConvexHull, PyHeightField, PyScaled, PyTriMesh};
 use crate::convert::{scalar, vec3, vec3_out};
 use crate::errors::core;
 use crate::shape::PyShape;
@@ -54,6 +54,7 @@ pub fn wrap_shape(py: Python<'_>, shape: Arc<Shape>) -> PyResult<Bound<'_, PyAny
         Shape::Triangle(_) => wrap(py, shape, PyTriangle),
         Shape::Plane(_) => wrap(py, shape, PyPlane),
         Shape::TriMesh(_) => wrap(py, shape, PyTriMesh),
+        Shape::HeightField(_) => wrap(py, shape, PyHeightField),
         Shape::Compound(_) => wrap(py, shape, PyCompound),
         Shape::Scaled(_) => wrap(py, shape, PyScaled),
     }
@@ -71,6 +72,7 @@ pub fn kind_str(shape: &Shape) -> &'static str {
         Shape::Triangle(_) => "triangle",
         Shape::Plane(_) => "plane",
         Shape::TriMesh(_) => "trimesh",
+        Shape::HeightField(_) => "heightfield",
         Shape::Compound(_) => "compound",
         Shape::Scaled(_) => "scaled",
     }
@@ -87,6 +89,7 @@ fn class_name(shape: &Shape) -> &'static str {
         Shape::Triangle(_) => "Triangle",
         Shape::Plane(_) => "Plane",
         Shape::TriMesh(_) => "TriMesh",
+        Shape::HeightField(_) => "HeightField",
         Shape::Compound(_) => "Compound",
         Shape::Scaled(_) => "Scaled",
     }
@@ -141,6 +144,16 @@ pub fn repr_shape(shape: &Shape) -> String {
             m.vertices().len(),
             m.num_triangles()
         ),
+        Shape::HeightField(h) => {
+            let (dx, dz) = h.cell_size();
+            format!(
+                "HeightField(<{} x {} samples, cell_size=({}, {})>)",
+                h.rows(),
+                h.cols(),
+                fmt_real(dx),
+                fmt_real(dz)
+            )
+        }
         Shape::Compound(c) => {
             let names: Vec<&str> = c
                 .children()
