@@ -75,8 +75,15 @@ mod tests {
 
     #[test]
     fn round_trip() {
-        for x in [-3.5, 0.0, 1e-20, 7.25e10] {
+        // Values representable in f32 round-trip exactly.
+        for x in [-3.5, 0.0, 0.5, 1024.0, -65536.0] {
             assert_eq!(ordered_to_real(real_floor_key(x)), x);
+        }
+        // Others (in the f64 build) are bracketed: floor key <= x <= ceil key.
+        for x in [1e-20, 7.25e10, -0.1] {
+            assert!(
+                ordered_to_real(real_floor_key(x)) <= x && x <= ordered_to_real(real_ceil_key(x))
+            );
         }
     }
 }
