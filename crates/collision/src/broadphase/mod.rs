@@ -11,7 +11,8 @@
 //!
 //! Methods:
 //! - [`TreeBroadPhase`]: two dynamic AABB trees, moving and resting (Bullet's
-//!   `btDbvtBroadphase`, Box2D v3's `b2BroadPhase`), built on [`DynamicTree`];
+//!   `btDbvtBroadphase`, Box2D v3's `b2BroadPhase`), built on [`DynamicTree`] (from
+//!   [`crate::bvh`]);
 //! - [`SweepAndPrune`]: incremental three-axis sweep-and-prune (Bullet's `btAxisSweep3`);
 //! - [`SortSweep`]: one-axis sort-and-sweep from scratch each update, radix-sorted and
 //!   parallel (OPCODE's box pruning; Game Physics Pearls ch. 7);
@@ -24,7 +25,6 @@
 
 mod any;
 pub mod brute_force;
-mod dynamic_tree;
 pub mod grid;
 pub mod hgrid;
 mod pairs;
@@ -33,13 +33,11 @@ pub mod radix;
 pub mod sap;
 pub mod sort_sweep;
 mod tree_broadphase;
-mod tree_insert;
-mod tree_query;
-mod tree_validate;
 
+/// The dynamic AABB tree, moved to [`crate::bvh`] (compound shapes use it too).
+pub use crate::bvh::{DynamicTree, HalfSpace, InsertStrategy, TreeProxy};
 pub use any::{overlapping_pairs, AnyBroadPhase, Method};
 pub use brute_force::BruteForce;
-pub use dynamic_tree::{DynamicTree, InsertStrategy, TreeProxy};
 pub use grid::HashGrid;
 pub use hgrid::HierarchicalGrid;
 pub use pairs::{PairCache, PairChanges, UserFilter};
@@ -47,7 +45,6 @@ pub use proxies::ProxyStore;
 pub use sap::SweepAndPrune;
 pub use sort_sweep::SortSweep;
 pub use tree_broadphase::TreeBroadPhase;
-pub use tree_query::HalfSpace;
 
 use crate::error::Result;
 use crate::math::{Aabb, Vec3};

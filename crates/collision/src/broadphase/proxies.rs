@@ -2,7 +2,7 @@
 
 use super::{Filter, ProxyHandle};
 use crate::error::{CaromError, Result};
-use crate::math::Aabb;
+use crate::math::{check_aabb, Aabb};
 
 /// Dense storage of proxies: slot `i` holds the exact box, the filter and the generation of
 /// the proxy with index `i`. Removed slots are recycled only after [`ProxyStore::end_frame`]
@@ -16,17 +16,6 @@ pub struct ProxyStore {
     free: Vec<u32>,
     pending_free: Vec<u32>,
     len: usize,
-}
-
-/// Rejects NaN, infinite or inverted boxes, naming the bad value.
-pub fn check_aabb(aabb: &Aabb) -> Result<()> {
-    if !aabb.min.is_finite() || !aabb.max.is_finite() {
-        return Err(CaromError::invalid("aabb", aabb, "bounds must be finite"));
-    }
-    if !aabb.min.cmple(aabb.max).all() {
-        return Err(CaromError::invalid("aabb", aabb, "min must be <= max"));
-    }
-    Ok(())
 }
 
 impl ProxyStore {

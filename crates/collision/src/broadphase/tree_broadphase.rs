@@ -10,9 +10,9 @@
 //! Candidates are kept sorted; each update drops those whose fat boxes separated and reports
 //! those whose exact boxes overlap.
 
-use super::dynamic_tree::DynamicTree;
 use super::{pair_key, unpack_pair, BroadPhase, Filter, InsertStrategy};
 use super::{PairCache, PairChanges, ProxyHandle, ProxyStore, TreeProxy};
+use crate::bvh::DynamicTree;
 use crate::error::Result;
 use crate::math::{Aabb, Real, Vec3};
 

@@ -1,7 +1,7 @@
 //! Input validation helpers shared by every constructor. Each returns a [`CaromError`]
 //! naming the argument and its value.
 
-use super::{Isometry, Quat, Real, Vec3};
+use super::{Aabb, Isometry, Quat, Real, Vec3};
 use crate::error::{CaromError, Result};
 
 /// Checks that `x` is finite.
@@ -81,6 +81,17 @@ pub fn check_isometry(name: &str, iso: Isometry) -> Result<Isometry> {
         rotation,
         translation,
     })
+}
+
+/// Rejects NaN, infinite or inverted boxes, naming the bad value.
+pub fn check_aabb(aabb: &Aabb) -> Result<()> {
+    if !aabb.min.is_finite() || !aabb.max.is_finite() {
+        return Err(CaromError::invalid("aabb", aabb, "bounds must be finite"));
+    }
+    if !aabb.min.cmple(aabb.max).all() {
+        return Err(CaromError::invalid("aabb", aabb, "min must be <= max"));
+    }
+    Ok(())
 }
 
 #[cfg(test)]

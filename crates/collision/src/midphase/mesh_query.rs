@@ -5,8 +5,8 @@
 //! same exact leaf test; the BVH versions return identical results (ties on distance are
 //! broken by the smaller triangle index, so results do not depend on the visit order).
 
-use super::bvh::Bvh;
 use super::triangle_query::{closest_point_on_triangle, TriangleRayHit, WatertightRay};
+use crate::bvh::Bvh;
 use crate::math::{Aabb, Isometry, Real, Vec3};
 
 /// A ray hit on a mesh.
@@ -47,20 +47,6 @@ pub struct MeshView<'a> {
     pub vertices: &'a [Vec3],
     /// Triangles as vertex index triples.
     pub indices: &'a [[u32; 3]],
-}
-
-/// Bounding box of each triangle, the primitive boxes of a mesh BVH.
-pub fn triangle_aabbs(vertices: &[Vec3], indices: &[[u32; 3]]) -> Vec<Aabb> {
-    indices
-        .iter()
-        .map(|t| {
-            Aabb::from_points([
-                vertices[t[0] as usize],
-                vertices[t[1] as usize],
-                vertices[t[2] as usize],
-            ])
-        })
-        .collect()
 }
 
 /// The prepared ray, or `None` for an invalid ray (non-finite, zero direction, NaN or

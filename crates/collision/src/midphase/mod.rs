@@ -2,22 +2,26 @@
 //! can touch a query, following Coumans' SIGGRAPH 2010 talk ("Midphase culling: detect
 //! overlapping triangles (trimesh), detect overlapping child shapes (compound)").
 //!
-//! - [`Bvh`]: a static, stackless BVH with quantised 16-byte nodes (or unquantised ones),
-//!   binned-SAH build and refit.
-//! - Triangle queries over a BVH: box overlap, rays (closest, any, all), closest point,
+//! - Triangle queries over a mesh's [`Bvh`] ([`MeshView`], and the methods of
+//!   [`crate::shape::TriMesh`]): box overlap, rays (closest, any, all), closest point,
 //!   mesh-vs-mesh triangle pairs.
+//! - Heightfield queries (the grid is its own structure) and compound child queries.
+//!
+//! The hierarchies themselves live in [`crate::bvh`] (re-exported here); this module comes
+//! right after `shape` and before `query`, whose ray casts and point projections on meshes
+//! and heightfields use these traversals.
 
-mod build;
-mod bvh;
 mod compound_query;
 mod heightfield_query;
 mod mesh_query;
-mod pair;
-mod traverse;
 mod triangle_query;
+mod trimesh_query;
 
-pub use build::{MAX_LEAF_SIZE, NUM_BINS};
-pub use bvh::{Bvh, BvhLayout, Quantization, QuantizedNode, UnquantizedNode, MAX_PRIMITIVES};
+pub use crate::bvh::{
+    Bvh, BvhLayout, Quantization, QuantizedNode, UnquantizedNode, MAX_LEAF_SIZE, MAX_PRIMITIVES,
+    NUM_BINS,
+};
+pub use crate::shape::triangle_aabbs;
 pub use compound_query::child_pair_overlaps;
-pub use mesh_query::{brute_force, triangle_aabbs, MeshPointProjection, MeshRayHit, MeshView};
+pub use mesh_query::{brute_force, MeshPointProjection, MeshRayHit, MeshView};
 pub use triangle_query::{closest_point_on_triangle, ray_triangle, TriangleRayHit, WatertightRay};

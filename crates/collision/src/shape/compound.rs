@@ -1,10 +1,10 @@
 //! Compound shape: child shapes at local poses, with a static BVH over the children's boxes
-//! (`midphase::Bvh`) for child-overlap queries (`midphase::compound_query`).
+//! ([`crate::bvh::Bvh`]) for child-overlap queries (`midphase::compound_query`).
 
 use super::{MassProperties, Shape};
+use crate::bvh::{Bvh, BvhLayout};
 use crate::error::{CaromError, Result};
 use crate::math::{check_isometry, Aabb, Isometry, Real};
-use crate::midphase::{Bvh, BvhLayout};
 use serde::{Deserialize, Serialize};
 use std::sync::Arc;
 

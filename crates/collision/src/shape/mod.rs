@@ -39,7 +39,7 @@ pub use scaled::Scaled;
 pub use sphere::Sphere;
 pub use support::SupportMap;
 pub use triangle::Triangle;
-pub use trimesh::{TriMesh, TriMeshOptions};
+pub use trimesh::{triangle_aabbs, TriMesh, TriMeshOptions};
 pub use trimesh_edges::{
     compute_edges, weld_vertices, EdgeKind, MeshEdge, DEFAULT_FLAT_ANGLE, NO_NEIGHBOR,
 };

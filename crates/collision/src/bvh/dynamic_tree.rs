@@ -210,7 +210,7 @@ impl DynamicTree {
     /// Inserts a leaf for an object with box `aabb` (validated) and user data `user`; the
     /// leaf stores the fat box.
     pub fn create_proxy(&mut self, aabb: Aabb, user: u32) -> Result<TreeProxy> {
-        super::proxies::check_aabb(&aabb)?;
+        crate::math::check_aabb(&aabb)?;
         let fat = self.fat_aabb(&aabb, Vec3::ZERO);
         Ok(self.create_proxy_fat(fat, user))
     }
@@ -246,7 +246,7 @@ impl DynamicTree {
     /// `true`.
     pub fn move_proxy(&mut self, proxy: TreeProxy, aabb: Aabb, displacement: Vec3) -> Result<bool> {
         let i = self.check(proxy)?;
-        super::proxies::check_aabb(&aabb)?;
+        crate::math::check_aabb(&aabb)?;
         let fat = self.nodes[i].aabb;
         if fat.contains(&aabb) {
             // Shrink when the object stopped: a fat box far larger than a fresh one would

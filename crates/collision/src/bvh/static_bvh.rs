@@ -131,7 +131,7 @@ pub(crate) enum Nodes {
 }
 
 /// A static BVH over primitive boxes (triangles, heightfield cells, compound children).
-/// Build with [`Bvh::new`]; query with the traversals of `midphase`.
+/// Build with [`Bvh::new`]; query with the traversals in `bvh::traverse`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Bvh {
     pub(crate) nodes: Nodes,
@@ -196,7 +196,7 @@ fn check_boxes(boxes: &[Aabb]) -> Result<()> {
 }
 
 impl Bvh {
-    /// Builds a BVH over primitive boxes (binned SAH, see `midphase::build`). Primitive `i`
+    /// Builds a BVH over primitive boxes (binned SAH, see `bvh::build`). Primitive `i`
     /// is reported as `i` by the traversals. Errors for no boxes, invalid boxes, or more
     /// than [`MAX_PRIMITIVES`].
     pub fn new(boxes: &[Aabb], layout: BvhLayout) -> Result<Self> {

@@ -10,7 +10,9 @@
 //! Ray–box tests follow the robust slab test of Ize, "Robust BVH Ray Traversal" (JCGT 2013):
 //! the exit distance is scaled by `1 + 2γ₃` so a ray touching a box is never culled.
 
-use super::bvh::{leaf_range, Bvh, Nodes, Quantization, QuantizedNode, UnquantizedNode, LEAF_FLAG};
+use super::static_bvh::{
+    leaf_range, Bvh, Nodes, Quantization, QuantizedNode, UnquantizedNode, LEAF_FLAG,
+};
 use crate::math::{Aabb, Real, Vec3, Vec3A, EPSILON};
 
 /// `1 + 2γ₃` with `γₙ = nε / (1 - nε)` (Ize 2013), plus slack for the quantised mapping and

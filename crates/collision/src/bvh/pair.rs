@@ -6,7 +6,7 @@
 //! internal the one with the larger box is split. Boxes of B are moved into A's frame with
 //! Arvo's transform of the centre and `|R|`-mapped half extents, padded for rounding.
 
-use super::bvh::{leaf_range, Bvh, Nodes, LEAF_FLAG};
+use super::static_bvh::{leaf_range, Bvh, Nodes, LEAF_FLAG};
 use super::traverse::{right_child_of, with_nodes, NodeSet, QNodes};
 use crate::math::{Aabb, Isometry, EPSILON};
 
@@ -81,8 +81,8 @@ fn pair_walk<A: NodeSet, B: NodeSet>(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::bvh::BvhLayout;
     use crate::math::{Quat, Real, Vec3};
-    use crate::midphase::BvhLayout;
 
     #[test]
     fn pairs_match_brute_force_on_boxes() {
