@@ -213,6 +213,9 @@ class Compound(Shape):
     @property
     def children(self) -> list[Tuple[Shape, Pose]]: ...
     def overlapping_children(self, aabb_min: _ArrayLike, aabb_max: _ArrayLike) -> _I64: ...
+    def overlapping_child_pairs(
+        self, other: Compound, pose: Optional[_PoseLike] = None
+    ) -> _I64: ...
 
 @final
 class Scaled(Shape):

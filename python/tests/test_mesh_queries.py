@@ -238,3 +238,22 @@ def test_compound_overlapping_children_against_brute_force() -> None:
         got = comp.overlapping_children(c - h, c + h)
         expected = np.nonzero(((centers - 0.3 <= c + h) & (centers + 0.3 >= c - h)).all(axis=1))[0]
         np.testing.assert_array_equal(got, expected)
+
+
+def test_compound_child_pairs_against_brute_force() -> None:
+    rng = np.random.default_rng(10)
+    ca, cb = rng.uniform(-3, 3, (25, 3)), rng.uniform(-3, 3, (15, 3))
+    a = carom.Compound([(carom.Sphere(0.4), [*c, 0, 0, 0, 1]) for c in ca])
+    b = carom.Compound([(carom.Sphere(0.4), [*c, 0, 0, 0, 1]) for c in cb])
+    shift = np.array([0.5, -0.25, 0.0])
+    got = a.overlapping_child_pairs(b, [*shift, 0, 0, 0, 1])
+    moved = cb + shift
+    overlap = (np.abs(ca[:, None, :] - moved[None, :, :]) <= 0.8 + 1e-6).all(axis=2)
+    expected = np.argwhere(overlap)
+    assert got.shape == expected.shape and got.dtype == np.int64
+    np.testing.assert_array_equal(got, expected)
+    assert a.overlapping_child_pairs(b).shape[1] == 2
+    with pytest.raises(TypeError):
+        a.overlapping_child_pairs(carom.Sphere(1.0))  # type: ignore[arg-type]
+    with pytest.raises(ValueError):
+        a.overlapping_child_pairs(b, [np.nan, 0, 0, 0, 0, 0, 1])

@@ -375,6 +375,27 @@ impl PyCompound {
         crate::mesh::overlapping(slf.py(), aabb_min, aabb_max, |b| c.children_in_aabb(b))
     }
 
+    /// Child index pairs `(i, j)` as an `(N, 2)` int64 array, sorted, where child `i` of
+    /// this compound and child `j` of `other` (placed at `pose`, its pose in this
+    /// compound's frame; default identity) have overlapping bounding boxes, found by
+    /// descending both children's dynamic trees together.
+    #[pyo3(signature = (other, pose=None))]
+    fn overlapping_child_pairs<'py>(
+        slf: &Bound<'py, Self>,
+        other: &Bound<'py, PyCompound>,
+        pose: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyArray2<i64>>> {
+        let (Shape::Compound(a), Shape::Compound(b)) = (shape_of(slf), shape_of(other)) else {
+            return Err(wrong_kind("Compound"));
+        };
+        let pose = extract_isometry(pose, "pose")?;
+        let pairs = a.child_pairs(b, &pose);
+        Ok(Array2::from_shape_fn((pairs.len(), 2), |(i, j)| {
+            i64::from(if j == 0 { pairs[i].0 } else { pairs[i].1 })
+        })
+        .into_pyarray(slf.py()))
+    }
+
     /// The children as a list of `(shape, Pose)` pairs (poses at the core's precision,
     /// see `carom.REAL_BITS`).
     #[getter]

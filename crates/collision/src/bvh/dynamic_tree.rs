@@ -231,6 +231,18 @@ impl DynamicTree {
         }
     }
 
+    /// Replaces the user data of a leaf. A stale or unknown handle is an error.
+    pub fn set_user(&mut self, proxy: TreeProxy, user: u32) -> Result<()> {
+        let i = self.check(proxy)?;
+        self.nodes[i].user = user;
+        Ok(())
+    }
+
+    /// The user data of a leaf. A stale or unknown handle is an error.
+    pub fn user(&self, proxy: TreeProxy) -> Result<u32> {
+        Ok(self.nodes[self.check(proxy)?].user)
+    }
+
     /// Removes a leaf. A stale or unknown handle is an error.
     pub fn destroy_proxy(&mut self, proxy: TreeProxy) -> Result<()> {
         let i = self.check(proxy)? as u32;

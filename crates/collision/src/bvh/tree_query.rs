@@ -5,7 +5,7 @@
 
 use super::dynamic_tree::{DynamicTree, NULL};
 use super::TreeProxy;
-use crate::math::{Aabb, Real, Vec3};
+use crate::math::{Aabb, Isometry, Real, Vec3};
 
 /// A half-space `normal · x <= offset`: the inside of one plane of a convex volume such as a
 /// view frustum (normals point outwards).
@@ -180,6 +180,44 @@ impl DynamicTree {
                         stack.push((a, nb.child1));
                         stack.push((a, nb.child2));
                     }
+                }
+            }
+        }
+    }
+
+    /// Like [`DynamicTree::query_tree`] with `other` placed at `pose_ab` (its pose in
+    /// `self`'s frame): `other`'s node boxes are moved with [`Aabb::transformed`], which
+    /// bounds the moved contents, so no overlapping leaf pair is missed.
+    pub fn query_tree_transformed(
+        &self,
+        other: &DynamicTree,
+        pose_ab: &Isometry,
+        mut f: impl FnMut(u32, u32),
+    ) {
+        if self.root == NULL || other.root == NULL {
+            return;
+        }
+        let moved = |b: u32| other.nodes[b as usize].aabb.transformed(pose_ab);
+        let mut stack = Vec::with_capacity(128);
+        stack.push((self.root, other.root, moved(other.root)));
+        while let Some((a, b, box_b)) = stack.pop() {
+            let (na, nb) = (&self.nodes[a as usize], &other.nodes[b as usize]);
+            if !na.aabb.intersects(&box_b) {
+                continue;
+            }
+            match (na.is_leaf(), nb.is_leaf()) {
+                (true, true) => f(na.user, nb.user),
+                (false, false) if na.aabb.surface_area() < box_b.surface_area() => {
+                    stack.push((a, nb.child1, moved(nb.child1)));
+                    stack.push((a, nb.child2, moved(nb.child2)));
+                }
+                (true, false) => {
+                    stack.push((a, nb.child1, moved(nb.child1)));
+                    stack.push((a, nb.child2, moved(nb.child2)));
+                }
+                (false, _) => {
+                    stack.push((na.child1, b, box_b));
+                    stack.push((na.child2, b, box_b));
                 }
             }
         }

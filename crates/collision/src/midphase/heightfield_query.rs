@@ -3,8 +3,9 @@
 //! Traversal Algorithm for Ray Tracing", Eurographics 1987) over the XZ projection, testing
 //! the two triangles of each cell with the watertight ray–triangle test.
 
-use super::mesh_query::MeshRayHit;
-use super::triangle_query::WatertightRay;
+use super::mesh_query::{MeshPointProjection, MeshRayHit, TIE_SLACK};
+use super::triangle_query::{closest_point_on_triangle, WatertightRay};
+use super::triangle_source::face_normal;
 use crate::math::{Aabb, Real, Vec3, EPSILON};
 use crate::shape::HeightField;
 
@@ -78,15 +79,12 @@ impl HeightField {
         for k in 0..2 {
             let id = 2 * cell + k;
             let tri = self.triangle(id);
-            let limit = best.map_or(max_t, |b| b.t);
+            let limit = best.map_or(max_t, |b| b.t * TIE_SLACK);
             if let Some(h) = ray.intersect(&tri, limit) {
                 let better =
                     best.is_none_or(|b| h.t < b.t || (h.t == b.t && (id as u32) < b.triangle));
                 if better {
-                    let normal = (tri[1] - tri[0])
-                        .cross(tri[2] - tri[0])
-                        .try_normalize()
-                        .unwrap_or(Vec3::Y);
+                    let normal = face_normal(&tri, dir);
                     *best = Some(MeshRayHit {
                         triangle: id as u32,
                         t: h.t,
@@ -164,5 +162,40 @@ impl HeightField {
             }
         }
         best
+    }
+
+    /// The closest point of the heightfield's surface to `point` (local frame) within
+    /// `max_dist` (ties to the smaller triangle index). The cell under the point (clamped to
+    /// the grid) gives a first distance `d`; only triangles whose boxes meet the box of
+    /// radius `d` around the point can be closer, and those are found cell by cell.
+    pub fn closest_point(&self, point: Vec3, max_dist: Real) -> Option<MeshPointProjection> {
+        if !point.is_finite() || max_dist.is_nan() || max_dist < 0.0 {
+            return None;
+        }
+        let (c, r) = self.cell_of(point.x, point.z);
+        let cell = r as usize * (self.cols() - 1) + c as usize;
+        let mut bound = Real::INFINITY;
+        for id in [2 * cell, 2 * cell + 1] {
+            let (q, _) = closest_point_on_triangle(point, &self.triangle(id));
+            bound = bound.min((q - point).length());
+        }
+        // Slack for the rounding of the distances.
+        let radius = bound.min(max_dist) * (1.0 + 16.0 * EPSILON) + EPSILON;
+        let query = Aabb::new(point - Vec3::splat(radius), point + Vec3::splat(radius));
+        let mut best: Option<(Real, u32, Vec3, [Real; 3])> = None;
+        self.for_each_triangle_in_aabb(&query, |i| {
+            let (q, w) = closest_point_on_triangle(point, &self.triangle(i as usize));
+            let d = (q - point).length_squared();
+            if d <= max_dist * max_dist && best.is_none_or(|b| d < b.0 || (d == b.0 && i < b.1)) {
+                best = Some((d, i, q, w));
+            }
+            true
+        });
+        best.map(|(d, i, q, w)| MeshPointProjection {
+            triangle: i,
+            point: q,
+            distance: d.sqrt(),
+            barycentric: w,
+        })
     }
 }

@@ -7,7 +7,7 @@
 
 use super::triangle_query::{closest_point_on_triangle, TriangleRayHit, WatertightRay};
 use crate::bvh::Bvh;
-use crate::math::{Aabb, Isometry, Real, Vec3};
+use crate::math::{Aabb, Isometry, Real, Vec3, EPSILON};
 
 /// A ray hit on a mesh.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -48,6 +48,9 @@ pub struct MeshView<'a> {
     /// Triangles as vertex index triples.
     pub indices: &'a [[u32; 3]],
 }
+
+/// Factor admitting candidates tied with the best hit so far (see `ray_closest`).
+pub(crate) const TIE_SLACK: Real = 1.0 + 8.0 * EPSILON;
 
 /// The prepared ray, or `None` for an invalid ray (non-finite, zero direction, NaN or
 /// negative `max_t`).
@@ -153,7 +156,14 @@ impl<'a> MeshView<'a> {
         let mut best_hit = None;
         self.bvh
             .for_each_candidate_on_ray_ordered(origin, dir, max_t, |i, limit| {
-                if let Some(h) = ray.intersect(&self.triangle(i), *limit) {
+                // Once a hit is known, admit exact ties (the range check before the division
+                // can round a tied `t` just above the limit); `better` decides exactly.
+                let lim = if best.is_some() {
+                    *limit * TIE_SLACK
+                } else {
+                    *limit
+                };
+                if let Some(h) = ray.intersect(&self.triangle(i), lim) {
                     if better(h.t, i, best) {
                         *limit = h.t;
                         best = Some((h.t, i));

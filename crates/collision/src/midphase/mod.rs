@@ -15,6 +15,7 @@ mod compound_query;
 mod heightfield_query;
 mod mesh_query;
 mod triangle_query;
+mod triangle_source;
 mod trimesh_query;
 
 pub use crate::bvh::{
@@ -22,6 +23,9 @@ pub use crate::bvh::{
     NUM_BINS,
 };
 pub use crate::shape::triangle_aabbs;
-pub use compound_query::child_pair_overlaps;
+pub use compound_query::{
+    brute_force_child_pairs, brute_force_children_in_aabb, child_pair_overlaps,
+};
 pub use mesh_query::{brute_force, MeshPointProjection, MeshRayHit, MeshView};
 pub use triangle_query::{closest_point_on_triangle, ray_triangle, TriangleRayHit, WatertightRay};
+pub use triangle_source::TriangleSource;

@@ -2,8 +2,8 @@
 //!
 //! Exact closed forms for spheres, boxes, capsules, cylinders, planes, triangles and hulls
 //! (face planes inside, GJK outside); GJK (outside) and EPA (inside) against the exact
-//! support map for cones and scaled shapes. Meshes are surfaces here (the closest triangle,
-//! `inside` false); compounds take the child with the smallest signed distance.
+//! support map for cones and scaled shapes. Meshes and heightfields are surfaces here (the
+//! closest triangle through the midphase traversals, `inside` false); compounds take the child with the smallest signed distance.
 
 use super::closest_points::{closest_point_segment, closest_point_triangle};
 use super::epa::epa;
@@ -12,6 +12,7 @@ use super::result::PointProjection;
 use super::support_adapters::{Exact, PointSupport};
 use crate::error::Result;
 use crate::math::{check_finite_vec, Isometry, Real, Vec3};
+use crate::midphase::TriangleSource;
 use crate::shape::{ConvexHull, ConvexRef, Shape};
 
 /// Projects the world point `point` on `shape` at `pose`.
@@ -99,31 +100,12 @@ pub fn project_point_local(shape: &Shape, p: Vec3) -> PointProjection {
         Shape::Cone(_) | Shape::Scaled(_) => {
             project_convex_gjk(shape.as_convex().expect("convex kinds"), p)
         }
-        Shape::TriMesh(m) => {
-            let mut best = proj(p, Real::INFINITY);
-            for i in 0..m.num_triangles() {
-                let [a, b, c] = m.triangle(i);
-                let q = closest_point_triangle(p, a, b, c);
-                let d = (p - q).length();
-                if d < best.distance {
-                    best = proj(q, d);
-                }
-            }
-            PointProjection {
-                inside: false,
-                ..best
-            }
-        }
-        Shape::HeightField(m) => {
-            let mut best = proj(p, Real::INFINITY);
-            for i in 0..m.num_triangles() {
-                let [a, b, c] = m.triangle(i);
-                let q = closest_point_triangle(p, a, b, c);
-                let d = (p - q).length();
-                if d < best.distance {
-                    best = proj(q, d);
-                }
-            }
+        Shape::TriMesh(_) | Shape::HeightField(_) => {
+            // The midphase traversal (BVH or grid); surfaces are never "inside".
+            let src = TriangleSource::of(shape).expect("mesh kinds");
+            let best = src
+                .closest_point(p, Real::INFINITY)
+                .map_or(proj(p, Real::INFINITY), |c| proj(c.point, c.distance));
             PointProjection {
                 inside: false,
                 ..best

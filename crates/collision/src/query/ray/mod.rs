@@ -3,8 +3,8 @@
 //! Analytic for spheres, boxes, capsules, cylinders, planes, triangles and hulls (face-plane
 //! clipping, exact); cones (quadric); scaled shapes map the ray into the inner shape's frame (exact for every
 //! inner kind); [`raycast_convex_gjk`] (the GJK ray cast of [`gjk_ray`]) serves any
-//! support map; meshes test every triangle (brute
-//! force — the midphase BVH accelerates this elsewhere) and compounds recurse.
+//! support map; meshes and heightfields use the midphase traversals (BVH, grid) through
+//! [`TriangleSource`] and compounds recurse.
 //!
 //! **Solid** casts report a ray starting inside a shape as a hit at distance 0 with
 //! `inside = true` and normal `-dir`. **Hollow** casts report the exit point instead
@@ -23,6 +23,7 @@ use super::result::RayHit;
 use super::support_adapters::Exact;
 use crate::error::{CaromError, Result};
 use crate::math::{check_finite_vec, Isometry, Real, Vec3};
+use crate::midphase::TriangleSource;
 use crate::shape::{ConvexRef, Shape};
 
 /// A ray: `origin + t·dir` for `t` in `[0, max_distance]`, `dir` of unit length.
@@ -155,41 +156,20 @@ pub fn raycast_local(shape: &Shape, ray: &Ray, max_distance: Real, solid: bool) 
                 ..h
             })
         }
-        Shape::TriMesh(m) => {
-            let mut best: Option<RayHit> = None;
-            for i in 0..m.num_triangles() {
-                let [a, b, c] = m.triangle(i);
-                if let Some((t, n)) = ray_triangle(o, d, a, b, c) {
-                    if t >= 0.0 && t <= max_distance && best.is_none_or(|h| t < h.distance) {
-                        best = Some(RayHit {
-                            distance: t,
-                            point: o + d * t,
-                            normal: n.normalize(),
-                            inside: false,
-                            feature: Some(i as u32),
-                        });
-                    }
-                }
-            }
-            best
-        }
-        Shape::HeightField(m) => {
-            let mut best: Option<RayHit> = None;
-            for i in 0..m.num_triangles() {
-                let [a, b, c] = m.triangle(i);
-                if let Some((t, n)) = ray_triangle(o, d, a, b, c) {
-                    if t >= 0.0 && t <= max_distance && best.is_none_or(|h| t < h.distance) {
-                        best = Some(RayHit {
-                            distance: t,
-                            point: o + d * t,
-                            normal: n.normalize(),
-                            inside: false,
-                            feature: Some(i as u32),
-                        });
-                    }
-                }
-            }
-            best
+        Shape::TriMesh(_) | Shape::HeightField(_) => {
+            // The midphase traversal (BVH or grid); surfaces: the normal faces the origin.
+            let h = TriangleSource::of(shape)?.ray_closest(o, d, max_distance)?;
+            Some(RayHit {
+                distance: h.t,
+                point: h.point,
+                normal: if h.normal.dot(d) > 0.0 {
+                    -h.normal
+                } else {
+                    h.normal
+                },
+                inside: false,
+                feature: Some(h.triangle),
+            })
         }
         Shape::Compound(c) => {
             let mut best: Option<RayHit> = None;

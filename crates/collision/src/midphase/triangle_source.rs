@@ -1,0 +1,123 @@
+//! One entry point for the shapes made of triangles (meshes and heightfields), so callers
+//! such as `query::raycast` and `query::project_point` use the accelerated traversals (a
+//! mesh's BVH, a heightfield's grid) through one code path, with brute-force twins over every
+//! triangle as test oracles.
+
+use super::mesh_query::{MeshPointProjection, MeshRayHit};
+use super::triangle_query::{closest_point_on_triangle, WatertightRay};
+use crate::math::{Real, Vec3};
+use crate::shape::{HeightField, Shape, TriMesh};
+
+/// A shape made of triangles, queried through its own acceleration structure.
+#[derive(Debug, Clone, Copy)]
+pub enum TriangleSource<'a> {
+    /// A triangle mesh (its BVH).
+    Mesh(&'a TriMesh),
+    /// A heightfield (its grid).
+    HeightField(&'a HeightField),
+}
+
+impl<'a> TriangleSource<'a> {
+    /// The source of a mesh or heightfield shape; `None` for other kinds.
+    pub fn of(shape: &'a Shape) -> Option<Self> {
+        match shape {
+            Shape::TriMesh(m) => Some(TriangleSource::Mesh(m)),
+            Shape::HeightField(h) => Some(TriangleSource::HeightField(h)),
+            _ => None,
+        }
+    }
+
+    /// Number of triangles.
+    pub fn num_triangles(&self) -> usize {
+        match self {
+            TriangleSource::Mesh(m) => m.num_triangles(),
+            TriangleSource::HeightField(h) => h.num_triangles(),
+        }
+    }
+
+    /// The corners of triangle `i`.
+    pub fn triangle(&self, i: u32) -> [Vec3; 3] {
+        match self {
+            TriangleSource::Mesh(m) => m.triangle(i as usize),
+            TriangleSource::HeightField(h) => h.triangle(i as usize),
+        }
+    }
+
+    /// The closest hit of the ray `origin + t·dir`, `t ∈ [0, max_t]` (ties to the smaller
+    /// triangle index).
+    pub fn ray_closest(&self, origin: Vec3, dir: Vec3, max_t: Real) -> Option<MeshRayHit> {
+        match self {
+            TriangleSource::Mesh(m) => m.raycast(origin, dir, max_t),
+            TriangleSource::HeightField(h) => h.raycast(origin, dir, max_t),
+        }
+    }
+
+    /// The closest point to `point` within `max_dist` (ties to the smaller triangle index).
+    pub fn closest_point(&self, point: Vec3, max_dist: Real) -> Option<MeshPointProjection> {
+        match self {
+            TriangleSource::Mesh(m) => m.closest_point(point, max_dist),
+            TriangleSource::HeightField(h) => h.closest_point(point, max_dist),
+        }
+    }
+
+    /// [`TriangleSource::ray_closest`] by testing every triangle: the oracle.
+    pub fn brute_force_ray_closest(
+        &self,
+        origin: Vec3,
+        dir: Vec3,
+        max_t: Real,
+    ) -> Option<MeshRayHit> {
+        if max_t.is_nan() || max_t < 0.0 {
+            return None;
+        }
+        let ray = WatertightRay::new(origin, dir)?;
+        let mut best: Option<MeshRayHit> = None;
+        for i in 0..self.num_triangles() as u32 {
+            let tri = self.triangle(i);
+            if let Some(h) = ray.intersect(&tri, max_t) {
+                if best.is_none_or(|b| h.t < b.t) {
+                    best = Some(MeshRayHit {
+                        triangle: i,
+                        t: h.t,
+                        barycentric: h.barycentric,
+                        point: origin + dir * h.t,
+                        normal: face_normal(&tri, dir),
+                    });
+                }
+            }
+        }
+        best
+    }
+
+    /// [`TriangleSource::closest_point`] by testing every triangle: the oracle.
+    pub fn brute_force_closest_point(
+        &self,
+        point: Vec3,
+        max_dist: Real,
+    ) -> Option<MeshPointProjection> {
+        let mut best: Option<(Real, u32, Vec3, [Real; 3])> = None;
+        for i in 0..self.num_triangles() as u32 {
+            let (q, w) = closest_point_on_triangle(point, &self.triangle(i));
+            let d = (q - point).length_squared();
+            if d <= max_dist * max_dist && best.is_none_or(|b| d < b.0) {
+                best = Some((d, i, q, w));
+            }
+        }
+        best.map(|(d, i, q, w)| MeshPointProjection {
+            triangle: i,
+            point: q,
+            distance: d.sqrt(),
+            barycentric: w,
+        })
+    }
+}
+
+/// Unit counter-clockwise normal of a triangle, `-dir` normalised when degenerate (as
+/// [`MeshRayHit::normal`]).
+#[inline]
+pub(crate) fn face_normal(tri: &[Vec3; 3], dir: Vec3) -> Vec3 {
+    (tri[1] - tri[0])
+        .cross(tri[2] - tri[0])
+        .try_normalize()
+        .unwrap_or_else(|| -dir.normalize_or_zero())
+}
