@@ -179,6 +179,13 @@ fn bench_mesh(name: &str, v: Vec<Vec3>, t: Vec<[u32; 3]>, args: &Args) {
             .filter(|(o, d)| mesh.raycast(*o, *d, max_t).is_some())
             .count()
     });
+    let (t_sl, hits_sl) = median_time(args.runs, || {
+        let view = mesh.view();
+        rays.iter()
+            .filter(|(o, d)| view.ray_closest_stackless(*o, *d, max_t).is_some())
+            .count()
+    });
+    assert_eq!(hits_sl, hits_ours, "stackless and ordered walks disagree");
     let (t_uq, hits_uq) = median_time(args.runs, || {
         rays.iter()
             .filter(|(o, d)| uq.raycast(*o, *d, max_t).is_some())
@@ -248,6 +255,11 @@ fn bench_mesh(name: &str, v: Vec<Vec3>, t: Vec<[u32; 3]>, args: &Args) {
         n / t_uq / 1e6,
         n / t_parry_r / 1e6,
         t_parry_r / t_ours
+    );
+    println!(
+        "| closest-hit rays/s, 1 thread, stackless escape walk | {:.2}M | | | {:.2}x |",
+        n / t_sl / 1e6,
+        t_parry_r / t_sl
     );
     println!(
         "| closest-hit rays/s, {threads} threads | {:.2}M | | {:.2}M | {:.2}x |",

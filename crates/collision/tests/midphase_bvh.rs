@@ -73,6 +73,8 @@ fn check_rays(mesh: &Mesh, rng: &mut Rng, n: usize, inflate: Real) -> f64 {
                 want.map(|h| key(&h)),
                 "closest {origin} {dir}"
             );
+            let stackless = view.ray_closest_stackless(origin, dir, max_t);
+            assert_eq!(stackless.map(|h| key(&h)), got.map(|h| key(&h)));
             let any = view.ray_any(origin, dir, max_t);
             assert_eq!(any.is_some(), want.is_some());
             if let Some(h) = any {
