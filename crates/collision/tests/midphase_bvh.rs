@@ -268,3 +268,37 @@ fn quantized_nodes_are_small() {
     assert!(per_tri <= 32.0, "{per_tri} bytes per triangle");
     assert!(mesh.q.memory_bytes() < mesh.u.memory_bytes());
 }
+
+#[test]
+fn rays_along_edges_and_faces_match_brute_force() {
+    // Rays running along a triangle's edge line (in the plane of the two faces sharing it)
+    // and along the face plane through its centroid, on a wavy grid and a soup with
+    // degenerate triangles: every layout and walk equals brute force, nothing is NaN.
+    let mut rng = Rng(61);
+    for mesh in [
+        Mesh::new(grid_mesh(10, 10.0, Vec3::new(3.0, -1.0, 2.0))),
+        Mesh::new(soup_mesh(&mut rng, 200, -4.0, 4.0)),
+    ] {
+        for (k, tri) in mesh.t.iter().enumerate().step_by(3) {
+            let [a, b, c] = tri.map(|i| mesh.v[i as usize]);
+            let centroid = (a + b + c) / 3.0;
+            for (origin, dir) in [
+                (a - (b - a) * 2.0, b - a),
+                (centroid - (c - b) * 3.0, c - b),
+            ] {
+                let want = brute_force::ray_closest(&mesh.views()[0], origin, dir, 1e30);
+                for view in mesh.views() {
+                    for got in [
+                        view.ray_closest(origin, dir, 1e30),
+                        view.ray_closest_stackless(origin, dir, 1e30),
+                    ] {
+                        assert_eq!(got.map(|h| key(&h)), want.map(|h| key(&h)), "tri {k}");
+                        if let Some(h) = got {
+                            assert!(h.point.is_finite() && h.normal.is_finite());
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
