@@ -3,7 +3,7 @@
 //! Traversal Algorithm for Ray Tracing", Eurographics 1987) over the XZ projection, testing
 //! the two triangles of each cell with the watertight ray–triangle test.
 
-use super::mesh_query::{MeshPointProjection, MeshRayHit, TIE_SLACK};
+use super::mesh_query::{projection, MeshPointProjection, MeshRayHit, TIE_SLACK};
 use super::triangle_query::{closest_point_on_triangle, WatertightRay};
 use super::triangle_source::face_normal;
 use crate::math::{Aabb, Real, Vec3, EPSILON};
@@ -191,11 +191,6 @@ impl HeightField {
             }
             true
         });
-        best.map(|(d, i, q, w)| MeshPointProjection {
-            triangle: i,
-            point: q,
-            distance: d.sqrt(),
-            barycentric: w,
-        })
+        projection(best)
     }
 }

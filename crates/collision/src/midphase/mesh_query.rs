@@ -104,6 +104,38 @@ fn complete_hit(
     }
 }
 
+/// The projection from the best `(squared distance, triangle, point, barycentric)`.
+#[inline]
+pub(crate) fn projection(
+    best: Option<(Real, u32, Vec3, [Real; 3])>,
+) -> Option<MeshPointProjection> {
+    best.map(|(d, i, q, w)| MeshPointProjection {
+        triangle: i,
+        point: q,
+        distance: d.sqrt(),
+        barycentric: w,
+    })
+}
+
+/// The closest point of the triangles `0..n` (corners from `tri`) to `point` within
+/// `max_dist`, testing every one (ties to the smaller index): the brute-force oracle.
+pub(crate) fn brute_force_closest(
+    n: usize,
+    tri: impl Fn(u32) -> [Vec3; 3],
+    point: Vec3,
+    max_dist: Real,
+) -> Option<MeshPointProjection> {
+    let mut best: Option<(Real, u32, Vec3, [Real; 3])> = None;
+    for i in 0..n as u32 {
+        let (q, w) = closest_point_on_triangle(point, &tri(i));
+        let d = (q - point).length_squared();
+        if d <= max_dist * max_dist && better(d, i, best.map(|b| (b.0, b.1))) {
+            best = Some((d, i, q, w));
+        }
+    }
+    projection(best)
+}
+
 /// True when `(t, i)` orders before `best` (ties broken by the smaller index).
 #[inline]
 fn better(t: Real, i: u32, best: Option<(Real, u32)>) -> bool {
@@ -150,30 +182,7 @@ impl<'a> MeshView<'a> {
 
     /// The closest hit of the ray `origin + t·dir`, `t ∈ [0, max_t]`.
     pub fn ray_closest(&self, origin: Vec3, dir: Vec3, max_t: Real) -> Option<MeshRayHit> {
-        let ray = prepared(origin, dir, max_t)?;
-        // Keep (t, triangle) only; the hit is completed once, at the end.
-        let mut best: Option<(Real, u32)> = None;
-        let mut best_hit = None;
-        self.bvh
-            .for_each_candidate_on_ray_ordered(origin, dir, max_t, |i, limit| {
-                // Once a hit is known, admit exact ties (the range check before the division
-                // can round a tied `t` just above the limit); `better` decides exactly.
-                let lim = if best.is_some() {
-                    *limit * TIE_SLACK
-                } else {
-                    *limit
-                };
-                if let Some(h) = ray.intersect(&self.triangle(i), lim) {
-                    if better(h.t, i, best) {
-                        *limit = h.t;
-                        best = Some((h.t, i));
-                        best_hit = Some(h);
-                    }
-                }
-                true
-            });
-        let (_, i) = best?;
-        Some(complete_hit(&self.triangle(i), i, origin, dir, best_hit?))
+        self.ray_closest_walk(origin, dir, max_t, true)
     }
 
     /// [`MeshView::ray_closest`] with the stackless escape-index walk instead of the
@@ -185,25 +194,46 @@ impl<'a> MeshView<'a> {
         dir: Vec3,
         max_t: Real,
     ) -> Option<MeshRayHit> {
+        self.ray_closest_walk(origin, dir, max_t, false)
+    }
+
+    /// The closest hit through the ordered or the stackless walk.
+    #[inline(always)]
+    fn ray_closest_walk(
+        &self,
+        origin: Vec3,
+        dir: Vec3,
+        max_t: Real,
+        ordered: bool,
+    ) -> Option<MeshRayHit> {
         let ray = prepared(origin, dir, max_t)?;
+        // Keep (t, triangle) only; the hit is completed once, at the end.
         let mut best: Option<(Real, u32)> = None;
         let mut best_hit = None;
-        self.bvh
-            .for_each_candidate_on_ray(origin, dir, max_t, |i, limit| {
-                let lim = if best.is_some() {
-                    *limit * TIE_SLACK
-                } else {
-                    *limit
-                };
-                if let Some(h) = ray.intersect(&self.triangle(i), lim) {
-                    if better(h.t, i, best) {
-                        *limit = h.t;
-                        best = Some((h.t, i));
-                        best_hit = Some(h);
-                    }
+        let mut visit = |i: u32, limit: &mut Real| {
+            // Once a hit is known, admit exact ties (the range check before the division
+            // can round a tied `t` just above the limit); `better` decides exactly.
+            let lim = if best.is_some() {
+                *limit * TIE_SLACK
+            } else {
+                *limit
+            };
+            if let Some(h) = ray.intersect(&self.triangle(i), lim) {
+                if better(h.t, i, best) {
+                    *limit = h.t;
+                    best = Some((h.t, i));
+                    best_hit = Some(h);
                 }
-                true
-            });
+            }
+            true
+        };
+        if ordered {
+            self.bvh
+                .for_each_candidate_on_ray_ordered(origin, dir, max_t, &mut visit);
+        } else {
+            self.bvh
+                .for_each_candidate_on_ray(origin, dir, max_t, &mut visit);
+        }
         let (_, i) = best?;
         Some(complete_hit(&self.triangle(i), i, origin, dir, best_hit?))
     }
@@ -252,12 +282,7 @@ impl<'a> MeshView<'a> {
                 }
                 true
             });
-        best.map(|(d, i, q, w)| MeshPointProjection {
-            triangle: i,
-            point: q,
-            distance: d.sqrt(),
-            barycentric: w,
-        })
+        projection(best)
     }
 
     /// Triangle pairs `(a, b)`, `a` of `self` and `b` of `other` placed at `pose_ab` (B's pose
@@ -318,20 +343,7 @@ pub mod brute_force {
 
     /// The closest point within `max_dist` (ties to the smaller triangle index).
     pub fn closest_point(m: &MeshView, point: Vec3, max_dist: Real) -> Option<MeshPointProjection> {
-        let mut best: Option<(Real, u32, Vec3, [Real; 3])> = None;
-        for i in 0..m.indices.len() as u32 {
-            let (q, w) = closest_point_on_triangle(point, &m.triangle(i));
-            let d = (q - point).length_squared();
-            if d <= max_dist * max_dist && better(d, i, best.map(|b| (b.0, b.1))) {
-                best = Some((d, i, q, w));
-            }
-        }
-        best.map(|(d, i, q, w)| MeshPointProjection {
-            triangle: i,
-            point: q,
-            distance: d.sqrt(),
-            barycentric: w,
-        })
+        brute_force_closest(m.indices.len(), |i| m.triangle(i), point, max_dist)
     }
 
     /// All overlapping triangle pairs, sorted.

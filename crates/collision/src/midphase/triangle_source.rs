@@ -3,8 +3,8 @@
 //! mesh's BVH, a heightfield's grid) through one code path, with brute-force twins over every
 //! triangle as test oracles.
 
-use super::mesh_query::{MeshPointProjection, MeshRayHit};
-use super::triangle_query::{closest_point_on_triangle, WatertightRay};
+use super::mesh_query::{brute_force_closest, MeshPointProjection, MeshRayHit};
+use super::triangle_query::WatertightRay;
 use crate::math::{Real, Vec3};
 use crate::shape::{HeightField, Shape, TriMesh};
 
@@ -95,20 +95,7 @@ impl<'a> TriangleSource<'a> {
         point: Vec3,
         max_dist: Real,
     ) -> Option<MeshPointProjection> {
-        let mut best: Option<(Real, u32, Vec3, [Real; 3])> = None;
-        for i in 0..self.num_triangles() as u32 {
-            let (q, w) = closest_point_on_triangle(point, &self.triangle(i));
-            let d = (q - point).length_squared();
-            if d <= max_dist * max_dist && best.is_none_or(|b| d < b.0) {
-                best = Some((d, i, q, w));
-            }
-        }
-        best.map(|(d, i, q, w)| MeshPointProjection {
-            triangle: i,
-            point: q,
-            distance: d.sqrt(),
-            barycentric: w,
-        })
+        brute_force_closest(self.num_triangles(), |i| self.triangle(i), point, max_dist)
     }
 }
 
