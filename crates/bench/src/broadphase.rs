@@ -402,6 +402,12 @@ fn print_table(rows: &[Row], args: &Args, label: &str, metric: fn(&Row) -> f64) 
         }
         println!("{line}");
     }
+    let mut line = String::from("  N log N (ref.):");
+    for w in args.sizes.windows(2) {
+        let (a, b) = (w[0].max(2) as f64, w[1].max(2) as f64);
+        line += &format!("  {}->{}: {:.2}x", w[0], w[1], b * b.ln() / (a * a.ln()));
+    }
+    println!("{line}");
     println!("pairs growth (the output size bounds any method):");
     let pts: Vec<&Row> = args
         .sizes
