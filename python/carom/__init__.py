@@ -87,3 +87,8 @@ __all__ = [
     "time_of_impact",
     "__version__",
 ]
+
+# Broadphase: pairs of overlapping boxes, incremental broadphases, the dynamic AABB tree.
+from carom._carom import BroadPhase, DynamicTree, overlapping_pairs  # noqa: E402
+
+__all__ += ["BroadPhase", "DynamicTree", "overlapping_pairs"]

@@ -23,10 +23,17 @@ def stub_classes() -> dict[str, ast.ClassDef]:
 
 
 def stub_all() -> list[str]:
+    """`__all__ = [...]` plus every later `__all__ += [...]` of the stub."""
+    names: list[str] | None = None
     for n in TREE.body:
         if isinstance(n, ast.Assign) and any(isinstance(t, ast.Name) and t.id == "__all__" for t in n.targets):
-            return [ast.literal_eval(e) for e in n.value.elts]  # type: ignore[attr-defined]
-    raise AssertionError("no __all__ in the stub")
+            names = [ast.literal_eval(e) for e in n.value.elts]  # type: ignore[attr-defined]
+        elif isinstance(n, ast.AugAssign) and isinstance(n.target, ast.Name) and n.target.id == "__all__":
+            assert names is not None, "__all__ += before __all__ ="
+            names += [ast.literal_eval(e) for e in n.value.elts]  # type: ignore[attr-defined]
+    if names is None:
+        raise AssertionError("no __all__ in the stub")
+    return names
 
 
 def is_property(f: ast.FunctionDef) -> bool:

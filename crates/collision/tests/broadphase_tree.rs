@@ -293,3 +293,49 @@ fn sah_tree_is_not_worse_than_manhattan_on_clustered_boxes() {
     );
     assert!(sah < man, "SAH {sah} vs Manhattan {man}");
 }
+
+#[test]
+fn two_tree_invariants_hold_after_every_operation() {
+    // Both trees of the two-tree broadphase stay valid through creates, moves, removes,
+    // sleeping/waking migrations and static proxies, and their leaves partition the live
+    // proxies: resting or static ones in tree 1, moving ones in tree 0.
+    use carom_collision::broadphase::{BroadPhase, Filter, ProxyHandle, TreeBroadPhase};
+    for s in STRATEGIES {
+        for (k, &scene) in SCENES.iter().enumerate() {
+            let mut rng = Rng(900 + k as u64);
+            let mut bp = TreeBroadPhase::new(s, 0.05);
+            let check = |bp: &TreeBroadPhase, live: &[ProxyHandle]| {
+                bp.tree(0).validate().unwrap();
+                bp.tree(1).validate().unwrap();
+                let resting = live.iter().filter(|&&h| bp.is_resting(h).unwrap()).count();
+                assert_eq!(bp.tree(1).len(), resting);
+                assert_eq!(bp.tree(0).len(), live.len() - resting);
+            };
+            let mut live = Vec::new();
+            for _ in 0..60 {
+                let f = Filter::new(rng.below(6) == 0);
+                live.push(bp.create_proxy(random_box(&mut rng, scene), f).unwrap());
+                check(&bp, &live);
+            }
+            for _frame in 0..4 {
+                for i in 0..live.len() {
+                    let h = live[i];
+                    match rng.below(10) {
+                        0..=5 => {
+                            let (nb, d) = moved_box(&mut rng, &bp.aabb(h).unwrap(), scene);
+                            bp.update_proxy(h, nb, d).unwrap();
+                        }
+                        6 | 7 => bp.set_resting(h, rng.below(2) == 0).unwrap(),
+                        _ => {}
+                    }
+                    check(&bp, &live);
+                }
+                let gone = live.remove(rng.below(live.len()));
+                bp.remove_proxy(gone).unwrap();
+                check(&bp, &live);
+                bp.update_pairs();
+                check(&bp, &live);
+            }
+        }
+    }
+}

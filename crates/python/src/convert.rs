@@ -169,21 +169,23 @@ pub fn require_finite(name: &str, vs: &[Vec3]) -> PyResult<()> {
     }
 }
 
-/// Triangle (or other) index triples from an integer array of shape `(M, 3)`.
-pub fn index_triples(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<Vec<[u32; 3]>> {
-    let py = obj.py();
+/// `numpy.asarray(obj)` checked to hold integers (an empty array of any dtype passes);
+/// `None`, strings and non-integer arrays are a `TypeError` saying `name` must be `what`.
+pub fn integer_array<'py>(
+    obj: &Bound<'py, PyAny>,
+    name: &str,
+    what: &str,
+) -> PyResult<Bound<'py, PyAny>> {
     if obj.is_none() || obj.is_instance_of::<PyString>() || obj.is_instance_of::<PyBytes>() {
         return Err(PyTypeError::new_err(format!(
-            "{name} must be an integer array of shape (M, 3), got {}",
+            "{name} must be {what}, got {}",
             type_name(obj)
         )));
     }
-    let np = py.import("numpy")?;
-    let arr = np.call_method1("asarray", (obj,)).map_err(|e| {
-        PyTypeError::new_err(format!(
-            "{name} must be an integer array of shape (M, 3): {e}"
-        ))
-    })?;
+    let np = obj.py().import("numpy")?;
+    let arr = np
+        .call_method1("asarray", (obj,))
+        .map_err(|e| PyTypeError::new_err(format!("{name} must be {what}: {e}")))?;
     let kind: String = arr.getattr("dtype")?.getattr("kind")?.extract()?;
     let size: usize = arr.getattr("size")?.extract()?;
     if !(matches!(kind.as_str(), "i" | "u") || size == 0) {
@@ -192,6 +194,13 @@ pub fn index_triples(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<Vec<[u32; 3
             arr.getattr("dtype")?.str()?
         )));
     }
+    Ok(arr)
+}
+
+/// Triangle (or other) index triples from an integer array of shape `(M, 3)`.
+pub fn index_triples(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<Vec<[u32; 3]>> {
+    let arr = integer_array(obj, name, "an integer array of shape (M, 3)")?;
+    let kind: String = arr.getattr("dtype")?.getattr("kind")?.extract()?;
     let shape: Vec<usize> = arr.getattr("shape")?.extract()?;
     if !(shape.len() == 2 && shape[1] == 3) {
         return Err(invalid(format!(

@@ -10,8 +10,10 @@
 #![allow(clippy::useless_conversion)]
 
 mod batch;
+mod broadphase;
 mod composite;
 mod convert;
+mod dynamic_tree;
 mod errors;
 mod mesh;
 mod pose;
@@ -48,5 +50,8 @@ fn _carom(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<composite::PyScaled>()?;
     m.add_class::<mesh::PyMeshRayHits>()?;
     queries::register(m)?;
+    m.add_function(wrap_pyfunction!(broadphase::overlapping_pairs, m)?)?;
+    m.add_class::<broadphase::PyBroadPhase>()?;
+    m.add_class::<dynamic_tree::PyDynamicTree>()?;
     Ok(())
 }

@@ -1,10 +1,8 @@
 //! The brute-force all-pairs broadphase: the reference every other method is tested against
 //! (as Jolt keeps `BroadPhaseBruteForce` beside its quad-tree broadphase).
 
-use super::{impl_common_broadphase, pair_key, BroadPhase, Filter, PairCache, PairChanges};
-use super::{ProxyHandle, ProxyStore};
-use crate::error::Result;
-use crate::math::{Aabb, Vec3};
+use super::impl_rebuilt_proxies;
+use super::{impl_common_broadphase, pair_key, BroadPhase, PairCache, PairChanges, ProxyStore};
 
 /// Tests every pair of live proxies, O(N²) per update. Obviously correct; the oracle.
 #[derive(Debug, Clone, Default)]
@@ -25,22 +23,6 @@ impl BroadPhase for BruteForce {
         "brute_force"
     }
 
-    fn create_proxy(&mut self, aabb: Aabb, filter: Filter) -> Result<ProxyHandle> {
-        self.store.create(aabb, filter)
-    }
-
-    fn update_proxy(&mut self, proxy: ProxyHandle, aabb: Aabb, _displacement: Vec3) -> Result<()> {
-        self.store.set_aabb(proxy, aabb).map(|_| ())
-    }
-
-    fn remove_proxy(&mut self, proxy: ProxyHandle) -> Result<()> {
-        self.store.remove(proxy).map(|_| ())
-    }
-
-    fn set_resting(&mut self, proxy: ProxyHandle, _resting: bool) -> Result<()> {
-        self.store.check(proxy).map(|_| ())
-    }
-
     fn update_pairs(&mut self) -> &PairChanges {
         let live = self.store.live_indices();
         let boxes = self.store.aabbs();
@@ -57,4 +39,5 @@ impl BroadPhase for BruteForce {
     }
 
     impl_common_broadphase!();
+    impl_rebuilt_proxies!();
 }

@@ -9,10 +9,9 @@
 //! de-duplication pass is needed. Boxes spanning too many cells go to an "oversize" list
 //! tested against everything. [`GridLevel`] is shared with the hierarchical grid.
 
+use super::impl_rebuilt_proxies;
 use super::radix::radix_sort_by_key;
-use super::{impl_common_broadphase, pair_key, BroadPhase, Filter, PairCache, PairChanges};
-use super::{ProxyHandle, ProxyStore};
-use crate::error::Result;
+use super::{impl_common_broadphase, pair_key, BroadPhase, PairCache, PairChanges, ProxyStore};
 use crate::math::{Aabb, Real, Vec3};
 
 /// Boxes covering more cells than this are handled by the oversize list.
@@ -262,22 +261,6 @@ impl BroadPhase for HashGrid {
         "grid"
     }
 
-    fn create_proxy(&mut self, aabb: Aabb, filter: Filter) -> Result<ProxyHandle> {
-        self.store.create(aabb, filter)
-    }
-
-    fn update_proxy(&mut self, proxy: ProxyHandle, aabb: Aabb, _displacement: Vec3) -> Result<()> {
-        self.store.set_aabb(proxy, aabb).map(|_| ())
-    }
-
-    fn remove_proxy(&mut self, proxy: ProxyHandle) -> Result<()> {
-        self.store.remove(proxy).map(|_| ())
-    }
-
-    fn set_resting(&mut self, proxy: ProxyHandle, _resting: bool) -> Result<()> {
-        self.store.check(proxy).map(|_| ())
-    }
-
     fn update_pairs(&mut self) -> &PairChanges {
         let live = self.store.live_indices();
         let boxes = self.store.aabbs();
@@ -315,4 +298,5 @@ impl BroadPhase for HashGrid {
     }
 
     impl_common_broadphase!();
+    impl_rebuilt_proxies!();
 }

@@ -9,10 +9,9 @@
 //! box, in the lowest common cell.
 
 use super::grid::{oversize_pairs, CellEntry, GridLevel};
-use super::{impl_common_broadphase, BroadPhase, Filter, PairCache, PairChanges};
-use super::{ProxyHandle, ProxyStore};
-use crate::error::Result;
-use crate::math::{Aabb, Real, Vec3};
+use super::impl_rebuilt_proxies;
+use super::{impl_common_broadphase, BroadPhase, PairCache, PairChanges, ProxyStore};
+use crate::math::Real;
 
 /// At most this many levels (sizes spanning a factor 2³¹ above the smallest).
 const MAX_LEVELS: usize = 32;
@@ -41,22 +40,6 @@ impl HierarchicalGrid {
 impl BroadPhase for HierarchicalGrid {
     fn name(&self) -> &'static str {
         "hgrid"
-    }
-
-    fn create_proxy(&mut self, aabb: Aabb, filter: Filter) -> Result<ProxyHandle> {
-        self.store.create(aabb, filter)
-    }
-
-    fn update_proxy(&mut self, proxy: ProxyHandle, aabb: Aabb, _displacement: Vec3) -> Result<()> {
-        self.store.set_aabb(proxy, aabb).map(|_| ())
-    }
-
-    fn remove_proxy(&mut self, proxy: ProxyHandle) -> Result<()> {
-        self.store.remove(proxy).map(|_| ())
-    }
-
-    fn set_resting(&mut self, proxy: ProxyHandle, _resting: bool) -> Result<()> {
-        self.store.check(proxy).map(|_| ())
     }
 
     fn update_pairs(&mut self) -> &PairChanges {
@@ -112,4 +95,5 @@ impl BroadPhase for HierarchicalGrid {
     }
 
     impl_common_broadphase!();
+    impl_rebuilt_proxies!();
 }

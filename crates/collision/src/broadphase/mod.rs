@@ -214,6 +214,46 @@ macro_rules! impl_common_broadphase {
 }
 pub(crate) use impl_common_broadphase;
 
+/// Implements the proxy methods of [`BroadPhase`] (create, update, remove, set_resting) for
+/// the methods that rebuild their structure from the stored boxes at every update (brute
+/// force, sort-and-sweep, the grids): they only validate and store, in `store: ProxyStore`.
+macro_rules! impl_rebuilt_proxies {
+    () => {
+        fn create_proxy(
+            &mut self,
+            aabb: $crate::math::Aabb,
+            filter: $crate::broadphase::Filter,
+        ) -> $crate::error::Result<$crate::broadphase::ProxyHandle> {
+            self.store.create(aabb, filter)
+        }
+
+        fn update_proxy(
+            &mut self,
+            proxy: $crate::broadphase::ProxyHandle,
+            aabb: $crate::math::Aabb,
+            _displacement: $crate::math::Vec3,
+        ) -> $crate::error::Result<()> {
+            self.store.set_aabb(proxy, aabb).map(|_| ())
+        }
+
+        fn remove_proxy(
+            &mut self,
+            proxy: $crate::broadphase::ProxyHandle,
+        ) -> $crate::error::Result<()> {
+            self.store.remove(proxy).map(|_| ())
+        }
+
+        fn set_resting(
+            &mut self,
+            proxy: $crate::broadphase::ProxyHandle,
+            _resting: bool,
+        ) -> $crate::error::Result<()> {
+            self.store.check(proxy).map(|_| ())
+        }
+    };
+}
+pub(crate) use impl_rebuilt_proxies;
+
 /// Packs an unordered pair of slot indices into a sort key `(min << 32) | max`.
 #[inline]
 pub(crate) fn pair_key(a: u32, b: u32) -> u64 {

@@ -10,10 +10,9 @@
 //! same on any number of threads. Nothing is kept between updates: cost does not depend on
 //! how far objects moved.
 
+use super::impl_rebuilt_proxies;
 use super::radix::par_sort_u64;
-use super::{impl_common_broadphase, pair_key, BroadPhase, Filter, PairCache, PairChanges};
-use super::{ProxyHandle, ProxyStore};
-use crate::error::Result;
+use super::{impl_common_broadphase, pair_key, BroadPhase, PairCache, PairChanges, ProxyStore};
 use crate::math::{ordered_to_real, real_floor_key, Aabb, Real, Vec3};
 
 /// Boxes swept per parallel task.
@@ -153,22 +152,6 @@ impl BroadPhase for SortSweep {
         "sort_sweep"
     }
 
-    fn create_proxy(&mut self, aabb: Aabb, filter: Filter) -> Result<ProxyHandle> {
-        self.store.create(aabb, filter)
-    }
-
-    fn update_proxy(&mut self, proxy: ProxyHandle, aabb: Aabb, _displacement: Vec3) -> Result<()> {
-        self.store.set_aabb(proxy, aabb).map(|_| ())
-    }
-
-    fn remove_proxy(&mut self, proxy: ProxyHandle) -> Result<()> {
-        self.store.remove(proxy).map(|_| ())
-    }
-
-    fn set_resting(&mut self, proxy: ProxyHandle, _resting: bool) -> Result<()> {
-        self.store.check(proxy).map(|_| ())
-    }
-
     fn update_pairs(&mut self) -> &PairChanges {
         let live = self.store.live_indices();
         let (keys, axis) = find_pairs(self.store.aabbs(), &live);
@@ -177,4 +160,5 @@ impl BroadPhase for SortSweep {
     }
 
     impl_common_broadphase!();
+    impl_rebuilt_proxies!();
 }
