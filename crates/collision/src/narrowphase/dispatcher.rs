@@ -68,7 +68,7 @@ fn swap(g: Generated, pose_ab: &Isometry) -> Generated {
 }
 
 /// The polyhedron view of boxes, hulls and triangles.
-pub fn as_polyhedron(c: ConvexRef<'_>) -> Option<Polyhedron> {
+pub fn as_polyhedron(c: ConvexRef<'_>) -> Option<Polyhedron<'_>> {
     match c {
         ConvexRef::Cuboid(b) => Some(Polyhedron::from_cuboid(b)),
         ConvexRef::ConvexHull(h) => Some(Polyhedron::from_hull(h)),

@@ -8,7 +8,7 @@
 mod capsule;
 mod compound;
 mod cone;
-mod convex_hull;
+pub(crate) mod convex_hull;
 mod cuboid;
 mod cylinder;
 mod heightfield;
