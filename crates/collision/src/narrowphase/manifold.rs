@@ -143,6 +143,12 @@ impl ContactManifold {
     /// Replaces the whole manifold by a freshly generated full one (the one-shot half of the
     /// hybrid method), carrying impulses and lifetimes over from matching cached points.
     pub fn replace_all(&mut self, mut new_points: Vec<ContactPoint>, merge_distance: Real) {
+        self.replace_with(&mut new_points, merge_distance);
+    }
+
+    /// [`ContactManifold::replace_all`] without allocating: the points are taken from
+    /// `new_points`, which receives the old points' buffer (cleared) for reuse.
+    pub fn replace_with(&mut self, new_points: &mut Vec<ContactPoint>, merge_distance: Real) {
         new_points.retain(|p| p.is_finite());
         for p in new_points.iter_mut() {
             if let Some(i) = self.find_match(p, merge_distance) {
@@ -152,7 +158,8 @@ impl ContactManifold {
                 p.lifetime = old.lifetime;
             }
         }
-        self.points = new_points;
+        std::mem::swap(&mut self.points, new_points);
+        new_points.clear();
         if self.points.len() > MAX_MANIFOLD_POINTS {
             self.reduce();
         }
@@ -175,7 +182,7 @@ impl ContactManifold {
         }
         let n = pts[i0].normal;
         let proj = |v: Vec3| v - n * v.dot(n);
-        let q: Vec<Vec3> = pts.iter().map(|p| proj(p.point_b)).collect();
+        let q: smallvec::SmallVec<[Vec3; 16]> = pts.iter().map(|p| proj(p.point_b)).collect();
         let argmax = |f: &dyn Fn(usize) -> Real| -> usize {
             let mut best = 0;
             let mut best_v = Real::NEG_INFINITY;
@@ -216,9 +223,17 @@ impl ContactManifold {
                 .map(|&(u, v)| -(q[v] - q[u]).cross(q[i] - q[u]).dot(n))
                 .fold(Real::NEG_INFINITY, Real::max)
         });
-        let mut keep = vec![i0, i1, i2, i3];
+        let mut keep = [i0, i1, i2, i3];
         keep.sort_unstable();
-        keep.dedup();
-        self.points = keep.into_iter().map(|i| pts[i]).collect();
+        let mut kept = [pts[0]; MAX_MANIFOLD_POINTS];
+        let mut n = 0;
+        for (k, &i) in keep.iter().enumerate() {
+            if k == 0 || keep[k - 1] != i {
+                kept[n] = pts[i];
+                n += 1;
+            }
+        }
+        self.points.clear();
+        self.points.extend_from_slice(&kept[..n]);
     }
 }
