@@ -55,6 +55,8 @@ from carom._carom import (
     time_of_impact,
     __version__,
 )
+from carom._carom import CollisionWorld, ContactEvents, Contacts, contact_manifold
+
 
 __all__ = [
     "REAL_BITS",
@@ -86,4 +88,8 @@ __all__ = [
     "shape_cast",
     "time_of_impact",
     "__version__",
+    "CollisionWorld",
+    "ContactEvents",
+    "Contacts",
+    "contact_manifold",
 ]

@@ -10,6 +10,7 @@
 #![allow(clippy::useless_conversion)]
 
 mod batch;
+mod collision_world;
 mod composite;
 mod convert;
 mod errors;
@@ -48,5 +49,6 @@ fn _carom(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<composite::PyScaled>()?;
     m.add_class::<mesh::PyMeshRayHits>()?;
     queries::register(m)?;
+    collision_world::register(m)?;
     Ok(())
 }

@@ -11,7 +11,10 @@ use super::convex::{
 };
 use super::manifold::{ContactManifold, ManifoldConfig};
 use super::mesh::{mesh_convex_contacts, mix_feature, ContactTriangles};
-use super::polyhedron::{plane_polyhedron_manifold, polyhedron_manifold_into, Polyhedron};
+use super::polyhedron::{
+    plane_polyhedron_manifold, polyhedron_manifold_guided, polyhedron_manifold_into, Polyhedron,
+    SAT_MAX_EDGE_PAIRS,
+};
 use crate::error::{CaromError, Result};
 use crate::math::Isometry;
 use crate::query::contact::{contact_convex_plane, contact_plane_convex};
@@ -132,7 +135,11 @@ pub fn convex_convex_into(
         (_, C::Capsule(_)) if as_polyhedron(a).is_some() => swapped(out),
         _ => match (as_polyhedron(a), as_polyhedron(b)) {
             (Some(pa), Some(pb)) => {
-                polyhedron_manifold_into(&pa, &pb, pose_ab, pred, out);
+                if pa.flat || pb.flat || pa.edges().len() * pb.edges().len() <= SAT_MAX_EDGE_PAIRS {
+                    polyhedron_manifold_into(&pa, &pb, pose_ab, pred, out);
+                } else {
+                    polyhedron_manifold_guided(&pa, &pb, a, b, pose_ab, pred, out);
+                }
                 true
             }
             // Perturb the shape, not the triangle (whose origin is the mesh's).
@@ -411,6 +418,8 @@ impl Dispatcher {
     /// One step of the persistent manifold: refresh from the poses, generate, then replace
     /// (full manifolds) or add point by point (the hybrid method). Works in per-thread
     /// scratch buffers: no heap allocation in the steady state for polyhedra and spheres.
+    /// While the relative pose stays within the coherence tolerances of the last full
+    /// generation ([`ContactManifold::is_coherent`]), the refreshed points are kept as they are.
     pub fn update_manifold(
         &self,
         a: &Shape,
@@ -424,8 +433,12 @@ impl Dispatcher {
                 const { RefCell::new((Vec::new(), Vec::new())) };
         }
         let cfg = &self.config;
+        let before = manifold.len();
         manifold.refresh(pose_a, pose_b, cfg.breaking_threshold);
         let pose_ab = pose_a.inv_mul(pose_b);
+        if manifold.len() == before && manifold.is_coherent(&pose_ab) {
+            return Ok(());
+        }
         SCRATCH.with(|cell| {
             // A re-entrant call (a user algorithm updating another manifold) gets fresh buffers.
             let mut fresh = Default::default();
@@ -442,6 +455,7 @@ impl Dispatcher {
                     .iter()
                     .map(|(c, id)| ContactPoint::from_local_contact(c, pose_a, pose_b, *id)),
             );
+            manifold.generated_at = full.then_some(pose_ab);
             if full {
                 manifold.replace_with(pts, cfg.merge_distance);
             } else {

@@ -46,7 +46,21 @@ impl Default for ManifoldConfig {
 pub struct ContactManifold {
     /// The points, in insertion order (stable across steps while they persist).
     pub points: Vec<ContactPoint>,
+    /// The relative pose (B in A's frame) at which the points were last generated as a full
+    /// one-shot manifold, or `None` (incremental points, or never): while the pose stays
+    /// within [`COHERENCE_ANGLE`] and [`COHERENCE_DISTANCE`] of it, the refreshed points are
+    /// kept without running contact generation again (spatial coherence, as Bullet's contact
+    /// caching and parry's `try_update_contacts`).
+    #[serde(default)]
+    pub generated_at: Option<Isometry>,
 }
+
+/// Relative rotation (radians) under which a manifold's points are reused unchanged.
+pub const COHERENCE_ANGLE: Real = 1.0 * crate::math::consts::PI / 180.0;
+
+/// Relative displacement (length units) of every contact point under which a manifold's
+/// points are reused unchanged.
+pub const COHERENCE_DISTANCE: Real = 1.0e-3;
 
 impl ContactManifold {
     /// An empty manifold.
@@ -67,6 +81,28 @@ impl ContactManifold {
     /// Removes every point.
     pub fn clear(&mut self) {
         self.points.clear();
+        self.generated_at = None;
+    }
+
+    /// True when the manifold holds a full manifold generated at a relative pose within
+    /// [`COHERENCE_ANGLE`] of `pose_ab`'s rotation and whose points moved less than
+    /// [`COHERENCE_DISTANCE`] since (so generating again would give the same points).
+    pub fn is_coherent(&self, pose_ab: &Isometry) -> bool {
+        let Some(p0) = self.generated_at else {
+            return false;
+        };
+        if self.points.is_empty() {
+            return false;
+        }
+        let cos_half = (0.5 * COHERENCE_ANGLE).cos();
+        if p0.rotation.dot(pose_ab.rotation).abs() < cos_half {
+            return false;
+        }
+        let tol2 = COHERENCE_DISTANCE * COHERENCE_DISTANCE;
+        self.points.iter().all(|p| {
+            let d = pose_ab.transform_point(p.local_b) - p0.transform_point(p.local_b);
+            d.length_squared() <= tol2
+        })
     }
 
     /// The deepest (smallest) distance, or `None` when empty.

@@ -8,9 +8,9 @@
 use super::contact::FeatureId;
 use crate::math::{Isometry, Real, Vec3};
 use crate::query::closest_points::closest_points_segment_segment;
-use crate::query::Contact;
+use crate::query::{contact_convex, Contact};
 use crate::shape::convex_hull::edge_face_pairs;
-use crate::shape::{ConvexHull, Cuboid, HullFace, Triangle};
+use crate::shape::{ConvexHull, ConvexRef, Cuboid, HullFace, Triangle};
 use smallvec::SmallVec;
 use std::sync::OnceLock;
 
@@ -469,6 +469,68 @@ pub fn polyhedron_manifold_into(
     } else {
         let id_base = (fa as u32 & 0x3F) << 24;
         clip_faces(a, fa, b, pose_ab, prediction, id_base, out);
+    }
+}
+
+/// Above this many edge pairs the separating-axis test (quadratic in the edge count) gives
+/// way to [`polyhedron_manifold_guided`].
+pub const SAT_MAX_EDGE_PAIRS: usize = 400;
+
+/// Cosine under which a contact normal counts as a face normal in
+/// [`polyhedron_manifold_guided`] (about 2.6 degrees).
+const FACE_COS: Real = 0.999;
+
+/// The full manifold of two polyhedra guided by GJK/EPA instead of the full SAT (the approach
+/// of parry's `contact_manifolds_pfm_pfm` and Bullet's `btPolyhedralContactClipping` after
+/// a GJK normal): one penetration query gives the normal `n`; when `n` is within about 2.6°
+/// of a face normal of A (or of B), that face is the reference face and the other shape's
+/// most anti-parallel face is clipped against it as in [`polyhedron_manifold`]; otherwise
+/// (edge–edge, vertex contacts) the single GJK/EPA point is the manifold. Cost: one GJK/EPA
+/// plus a scan of the faces, linear in the size of the shapes. `ca`/`cb` are the shapes
+/// behind the views `a`/`b`.
+#[allow(clippy::too_many_arguments)]
+pub fn polyhedron_manifold_guided(
+    a: &Polyhedron,
+    b: &Polyhedron,
+    ca: ConvexRef<'_>,
+    cb: ConvexRef<'_>,
+    pose_ab: &Isometry,
+    prediction: Real,
+    out: &mut Vec<(Contact, FeatureId)>,
+) {
+    let Some(c) = contact_convex(ca, cb, pose_ab, prediction) else {
+        return;
+    };
+    let best_face = |p: &Polyhedron, n: Vec3| {
+        p.faces()
+            .iter()
+            .enumerate()
+            .fold((0, Real::NEG_INFINITY), |best, (i, f)| {
+                let d = f.normal.dot(n);
+                if d > best.1 {
+                    (i, d)
+                } else {
+                    best
+                }
+            })
+    };
+    let (fa, da) = best_face(a, c.normal);
+    let (fb, db) = best_face(b, pose_ab.inverse_transform_vector(-c.normal));
+    let start = out.len();
+    if da >= FACE_COS && da + 1.0e-4 >= db {
+        let id_base = (fa as u32 & 0x3F) << 24;
+        clip_faces(a, fa, b, pose_ab, prediction, id_base, out);
+    } else if db >= FACE_COS {
+        let id_base = ((fb as u32 & 0x3F) | 0x40) << 24;
+        let mut tmp: SmallVec<[(Contact, FeatureId); 16]> = SmallVec::new();
+        clip_faces(b, fb, a, &pose_ab.inverse(), prediction, id_base, &mut tmp);
+        out.extend(
+            tmp.into_iter()
+                .map(|(c, id)| (c.swapped().transformed(pose_ab), id)),
+        );
+    }
+    if out.len() == start {
+        out.push((c, 0x8000_0000 | 0x7FFF_FFFF));
     }
 }
 
