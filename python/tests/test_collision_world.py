@@ -115,9 +115,12 @@ def test_heightfield_and_equivalent_mesh_give_the_same_manifold() -> None:
             m1 = carom.contact_manifold(hf, None, s, p, prediction=0.01)
             m2 = carom.contact_manifold(mesh, None, s, p, prediction=0.01)
             assert len(m1) == len(m2)
-            o1, o2 = np.lexsort(m1.point_b.T), np.lexsort(m2.point_b.T)
-            np.testing.assert_allclose(m1.point_b[o1], m2.point_b[o2], atol=10 * TOL)
-            np.testing.assert_allclose(m1.distance[o1], m2.distance[o2], atol=10 * TOL)
+            assert sorted(m1.feature.tolist()) == sorted(m2.feature.tolist())
+            for i in range(len(m1)):
+                j = m2.feature.tolist().index(m1.feature[i])
+                np.testing.assert_allclose(m1.point_b[i], m2.point_b[j], atol=10 * TOL)
+                np.testing.assert_allclose(m1.normal[i], m2.normal[j], atol=10 * TOL)
+                assert m1.distance[i] == pytest.approx(m2.distance[j], abs=10 * TOL)
             touching += len(m1) > 0
     assert touching > 10
 

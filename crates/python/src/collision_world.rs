@@ -170,9 +170,9 @@ pub fn contact_manifold(
     let pa = extract_isometry(Some(pose_a), "pose_a")?;
     let pb = extract_isometry(Some(pose_b), "pose_b")?;
     let pred = scalar("prediction", prediction)?;
-    if pred < 0.0 {
+    if !(pred >= 0.0 && pred.is_finite()) {
         return Err(invalid(format!(
-            "prediction must be >= 0, got {prediction}"
+            "prediction must be finite and >= 0, got {prediction}"
         )));
     }
     let d = Dispatcher::new(ManifoldConfig {

@@ -4,7 +4,7 @@
 //! registered for a pair of kinds overrides it; an unsupported pair is reported by
 //! [`Dispatcher::check_pair`] (called when an object is added), never silently skipped.
 
-use super::contact::{ContactPoint, FeatureId, NO_FEATURE};
+use super::contact::{ContactList, ContactPoint, FeatureId, NO_FEATURE};
 use super::convex::{
     capsule_capsule_manifold, capsule_polyhedron_manifold, perturbed_contacts,
     plane_capsule_manifold,
@@ -55,9 +55,6 @@ impl std::fmt::Debug for Dispatcher {
             .finish()
     }
 }
-
-/// A list of contacts with feature ids (A's frame, query convention).
-pub type ContactList = Vec<(Contact, FeatureId)>;
 
 fn swap(g: Generated, pose_ab: &Isometry) -> Generated {
     let mut contacts = g.contacts;

@@ -10,7 +10,7 @@
 //! concave edges (and the face interior) it becomes the face normal, on real convex edges
 //! it may turn up to the dihedral angle.
 
-use super::contact::FeatureId;
+use super::contact::{ContactList, FeatureId};
 use crate::math::Aabb;
 use crate::math::{Isometry, Real, Vec3};
 use crate::query::closest_points::closest_point_segment;
@@ -144,8 +144,8 @@ pub fn mesh_convex_contacts<M: ContactTriangles + ?Sized>(
     b: ConvexRef<'_>,
     pose_ab: &Isometry,
     prediction: Real,
-    tri_contacts: &mut dyn FnMut(&Triangle, &mut Vec<(Contact, FeatureId)>),
-    out: &mut Vec<(Contact, FeatureId)>,
+    tri_contacts: &mut dyn FnMut(&Triangle, &mut ContactList),
+    out: &mut ContactList,
 ) {
     let aabb = convex_aabb(b, pose_ab).expanded(prediction.max(0.0));
     mesh.for_each_candidate(&aabb, &mut |t| {

@@ -128,7 +128,7 @@ impl<'a> Polyhedron<'a> {
         };
         let face = |i: usize| {
             let mut normal = Vec3::ZERO;
-            normal[i / 2] = if i % 2 == 0 { 1.0 } else { -1.0 };
+            normal[i / 2] = if i.is_multiple_of(2) { 1.0 } else { -1.0 };
             HullFace {
                 normal,
                 offset: h[i / 2],
