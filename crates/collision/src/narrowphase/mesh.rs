@@ -16,6 +16,7 @@ use crate::math::{Isometry, Real, Vec3};
 use crate::query::closest_points::closest_point_segment;
 use crate::query::Contact;
 use crate::shape::{ConvexRef, EdgeKind, HeightField, MeshEdge, SupportMap, TriMesh, Triangle};
+use smallvec::SmallVec;
 
 /// A triangle soup with a midphase and precomputed (or derivable) edge convexity: what
 /// convex-vs-triangles contact generation needs. Implemented by [`TriMesh`] (BVH, edges
@@ -148,16 +149,21 @@ pub fn mesh_convex_contacts<M: ContactTriangles + ?Sized>(
     out: &mut ContactList,
 ) {
     let aabb = convex_aabb(b, pose_ab).expanded(prediction.max(0.0));
-    mesh.for_each_candidate(&aabb, &mut |t| {
+    // Triangles in index order, so a mesh and a heightfield with the same triangles give
+    // the same sequence of points (and the same reduced manifold).
+    let mut tris: SmallVec<[u32; 64]> = SmallVec::new();
+    mesh.for_each_candidate(&aabb, &mut |t| tris.push(t));
+    tris.sort_unstable();
+    for t in tris {
         let [p, q, r] = mesh.corners(t);
         let tri = Triangle { a: p, b: q, c: r };
         if tri.normal().is_none() || !tri.vertices().iter().all(|v| v.is_finite()) {
-            return;
+            continue;
         }
         let start = out.len();
         tri_contacts(&tri, out);
         if out.len() == start {
-            return;
+            continue;
         }
         let edges = mesh.triangle_edges(t);
         let mut keep = start;
@@ -170,5 +176,5 @@ pub fn mesh_convex_contacts<M: ContactTriangles + ?Sized>(
             }
         }
         out.truncate(keep);
-    });
+    }
 }
