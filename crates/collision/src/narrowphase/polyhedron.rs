@@ -474,7 +474,7 @@ pub fn polyhedron_manifold_into(
 
 /// Above this many edge pairs the separating-axis test (quadratic in the edge count) gives
 /// way to [`polyhedron_manifold_guided`].
-pub const SAT_MAX_EDGE_PAIRS: usize = 400;
+pub const SAT_MAX_EDGE_PAIRS: usize = 16;
 
 /// Cosine under which a contact normal counts as a face normal in
 /// [`polyhedron_manifold_guided`] (about 2.6 degrees).
