@@ -132,7 +132,7 @@ pub fn convex_convex_into(
         (_, C::Capsule(_)) if as_polyhedron(a).is_some() => swapped(out),
         _ => match (as_polyhedron(a), as_polyhedron(b)) {
             (Some(pa), Some(pb)) => {
-                if pa.edges().len() * pb.edges().len() <= SAT_MAX_EDGE_PAIRS {
+                if pa.flat || pb.flat || pa.edges().len() * pb.edges().len() <= SAT_MAX_EDGE_PAIRS {
                     polyhedron_manifold_into(&pa, &pb, pose_ab, pred, out);
                 } else {
                     polyhedron_manifold_guided(&pa, &pb, a, b, pose_ab, pred, out);

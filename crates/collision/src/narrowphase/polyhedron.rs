@@ -472,8 +472,9 @@ pub fn polyhedron_manifold_into(
     }
 }
 
-/// Above this many edge pairs the separating-axis test (quadratic in the edge count) gives
-/// way to [`polyhedron_manifold_guided`].
+/// Up to this many edge pairs (and always with a triangle) the dispatcher runs the full
+/// separating-axis test, quadratic in the edge count; boxes and hulls go through
+/// [`polyhedron_manifold_guided`].
 pub const SAT_MAX_EDGE_PAIRS: usize = 16;
 
 /// Cosine under which a contact normal counts as a face normal in
