@@ -28,7 +28,13 @@ use parry3d::shape::{SharedShape, TriMeshFlags};
 use std::hint::black_box;
 
 const N: usize = 64;
+/// The prediction distance of both libraries (carom's `ManifoldConfig::default()`).
 const PREDICTION: Real = 0.02;
+
+#[allow(clippy::unnecessary_cast)] // a no-op in the f32 build, a conversion in the f64 build
+fn pf(x: Real) -> f32 {
+    x as f32
+}
 
 struct Rng(u64);
 impl Rng {
@@ -193,6 +199,7 @@ fn cases() -> Vec<Case> {
 
 fn bench_contacts(c: &mut Criterion) {
     let d = Dispatcher::default();
+    assert_eq!(d.config.prediction, PREDICTION);
     let pd = DefaultQueryDispatcher;
     for case in cases() {
         let ppos: Vec<PPose> = case.poses.iter().map(pp).collect();
@@ -222,7 +229,7 @@ fn bench_contacts(c: &mut Criterion) {
                             m.clear();
                             *ws = None;
                         }
-                        pd.contact_manifolds(p, &*case.pa, &*case.pb, PREDICTION as f32, m, ws)
+                        pd.contact_manifolds(p, &*case.pa, &*case.pb, pf(PREDICTION), m, ws)
                             .unwrap();
                     }
                     black_box(&theirs);
