@@ -55,6 +55,8 @@ from carom._carom import (
     time_of_impact,
     __version__,
 )
+from carom._carom import CollisionWorld, ContactEvents, Contacts, contact_manifold
+
 
 __all__ = [
     "REAL_BITS",
@@ -86,6 +88,10 @@ __all__ = [
     "shape_cast",
     "time_of_impact",
     "__version__",
+    "CollisionWorld",
+    "ContactEvents",
+    "Contacts",
+    "contact_manifold",
 ]
 
 # Broadphase: pairs of overlapping boxes, incremental broadphases, the dynamic AABB tree.

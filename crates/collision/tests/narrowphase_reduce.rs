@@ -112,7 +112,7 @@ fn gauss_map_pruning_finds_the_unpruned_answer() {
             .unwrap()
             .unwrap();
         let (pa, pb) = (Polyhedron::from_hull(&ha), Polyhedron::from_hull(&hb));
-        let (mut qa, mut qb) = (pa.clone(), pb.clone());
+        let (mut qa, mut qb) = (pa, pb);
         qa.flat = true;
         qb.flat = true;
         let pruned = polyhedron_manifold(&pa, &pb, &pose, 0.0);

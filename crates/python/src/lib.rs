@@ -11,6 +11,7 @@
 
 mod batch;
 mod broadphase;
+mod collision_world;
 mod composite;
 mod convert;
 mod dynamic_tree;
@@ -53,5 +54,6 @@ fn _carom(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(broadphase::overlapping_pairs, m)?)?;
     m.add_class::<broadphase::PyBroadPhase>()?;
     m.add_class::<dynamic_tree::PyDynamicTree>()?;
+    collision_world::register(m)?;
     Ok(())
 }

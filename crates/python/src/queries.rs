@@ -235,7 +235,7 @@ impl PyShapeCastHit {
     }
 }
 
-fn shape_arg(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<Arc<Shape>> {
+pub(crate) fn shape_arg(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<Arc<Shape>> {
     obj.cast::<PyShape>()
         .map(|s| s.get().inner.clone())
         .map_err(|_| {

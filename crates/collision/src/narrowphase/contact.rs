@@ -11,6 +11,10 @@ use serde::{Deserialize, Serialize};
 /// produced a contact, so the same contact is recognised from one step to the next.
 pub type FeatureId = u32;
 
+/// Generated contacts with feature ids, in A's frame with the query convention (normal from
+/// A towards B): what the dispatcher's algorithms append to.
+pub type ContactList = Vec<(Contact, FeatureId)>;
+
 /// A feature id that matches nothing: such points are matched by distance only.
 pub const NO_FEATURE: FeatureId = u32::MAX;
 

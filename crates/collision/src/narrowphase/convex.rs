@@ -138,8 +138,8 @@ pub fn capsule_polyhedron_manifold(
     let nb = pose_ab.inverse_transform_vector(c0.normal);
     let mut face = None;
     let mut best: Real = 0.9999;
-    for (i, f) in poly.faces.iter().enumerate() {
-        let d = -f.0.dot(nb);
+    for (i, f) in poly.faces().iter().enumerate() {
+        let d = -f.normal.dot(nb);
         if d > best {
             best = d;
             face = Some(i);
@@ -150,12 +150,12 @@ pub fn capsule_polyhedron_manifold(
     };
     let pose_ba = pose_ab.inverse();
     let (p, q) = capsule_segment(a, &pose_ba);
-    let (fnorm, off, _, _) = poly.faces[fi];
+    let (fnorm, off) = (poly.faces()[fi].normal, poly.faces()[fi].offset);
     let (mut t0, mut t1): (Real, Real) = (0.0, 1.0);
     let lp = poly.face_loop(fi);
     for k in 0..lp.len() {
-        let v0 = poly.vertices[lp[k] as usize];
-        let v1 = poly.vertices[lp[(k + 1) % lp.len()] as usize];
+        let v0 = poly.vertices()[lp[k] as usize];
+        let v1 = poly.vertices()[lp[(k + 1) % lp.len()] as usize];
         let side = (v1 - v0).cross(fnorm).normalize_or_zero();
         let (dp, dq) = (side.dot(p - v0), side.dot(q - v0));
         if dp > 0.0 && dq > 0.0 {

@@ -4,19 +4,23 @@
 //! registered for a pair of kinds overrides it; an unsupported pair is reported by
 //! [`Dispatcher::check_pair`] (called when an object is added), never silently skipped.
 
-use super::contact::{ContactPoint, FeatureId, NO_FEATURE};
+use super::contact::{ContactList, ContactPoint, FeatureId, NO_FEATURE};
 use super::convex::{
     capsule_capsule_manifold, capsule_polyhedron_manifold, perturbed_contacts,
     plane_capsule_manifold,
 };
 use super::manifold::{ContactManifold, ManifoldConfig};
-use super::mesh::{mesh_convex_contacts, mix_feature};
-use super::polyhedron::{plane_polyhedron_manifold, polyhedron_manifold, Polyhedron};
+use super::mesh::{mesh_convex_contacts, mix_feature, ContactTriangles};
+use super::polyhedron::{
+    plane_polyhedron_manifold, polyhedron_manifold_guided, polyhedron_manifold_into, Polyhedron,
+    SAT_MAX_EDGE_PAIRS,
+};
 use crate::error::{CaromError, Result};
 use crate::math::Isometry;
 use crate::query::contact::{contact_convex_plane, contact_plane_convex};
 use crate::query::{contact_convex, Contact};
-use crate::shape::{ConvexRef, Plane, Shape, ShapeKind};
+use crate::shape::{ConvexRef, Plane, Shape, ShapeKind, Triangle};
+use std::cell::RefCell;
 use std::collections::BTreeMap;
 use std::sync::Arc;
 
@@ -52,23 +56,25 @@ impl std::fmt::Debug for Dispatcher {
     }
 }
 
-fn single(c: Option<Contact>) -> Vec<(Contact, FeatureId)> {
-    c.map(|c| vec![(c, NO_FEATURE)]).unwrap_or_default()
-}
-
 fn swap(g: Generated, pose_ab: &Isometry) -> Generated {
+    let mut contacts = g.contacts;
+    swap_from(&mut contacts, 0, pose_ab);
     Generated {
-        contacts: g
-            .contacts
-            .into_iter()
-            .map(|(c, id)| (c.swapped().transformed(pose_ab), id))
-            .collect(),
+        contacts,
         full: g.full,
     }
 }
 
+/// Turns the contacts `out[start..]`, computed with the shapes swapped (in B's frame), into
+/// A's frame with the query convention.
+fn swap_from(out: &mut [(Contact, FeatureId)], start: usize, pose_ab: &Isometry) {
+    for (c, _) in &mut out[start..] {
+        *c = c.swapped().transformed(pose_ab);
+    }
+}
+
 /// The polyhedron view of boxes, hulls and triangles.
-pub fn as_polyhedron(c: ConvexRef<'_>) -> Option<Polyhedron> {
+pub fn as_polyhedron(c: ConvexRef<'_>) -> Option<Polyhedron<'_>> {
     match c {
         ConvexRef::Cuboid(b) => Some(Polyhedron::from_cuboid(b)),
         ConvexRef::ConvexHull(h) => Some(Polyhedron::from_hull(h)),
@@ -86,38 +92,61 @@ pub fn convex_convex(
     cfg: &ManifoldConfig,
     want_full: bool,
 ) -> Generated {
+    let mut contacts = Vec::new();
+    let full = convex_convex_into(a, b, pose_ab, cfg, want_full, &mut contacts);
+    Generated { contacts, full }
+}
+
+/// [`convex_convex`] appending to `out`; returns whether the contacts form a full manifold.
+/// Polyhedron pairs (box, hull, triangle) and spheres allocate nothing beyond `out`.
+pub fn convex_convex_into(
+    a: ConvexRef<'_>,
+    b: ConvexRef<'_>,
+    pose_ab: &Isometry,
+    cfg: &ManifoldConfig,
+    want_full: bool,
+    out: &mut ContactList,
+) -> bool {
     use ConvexRef as C;
     let pred = cfg.prediction;
-    let full = |contacts| Generated {
-        contacts,
-        full: true,
+    let swapped = |out: &mut ContactList| {
+        let start = out.len();
+        let full = convex_convex_into(b, a, &pose_ab.inverse(), cfg, want_full, out);
+        swap_from(out, start, pose_ab);
+        full
     };
     match (a, b) {
-        (C::Sphere(_), _) | (_, C::Sphere(_)) => full(single(contact_convex(a, b, pose_ab, pred))),
-        (C::Capsule(x), C::Capsule(y)) => full(capsule_capsule_manifold(x, y, pose_ab, pred)),
+        (C::Sphere(_), _) | (_, C::Sphere(_)) => {
+            out.extend(contact_convex(a, b, pose_ab, pred).map(|c| (c, NO_FEATURE)));
+            true
+        }
+        (C::Capsule(x), C::Capsule(y)) => {
+            out.extend(capsule_capsule_manifold(x, y, pose_ab, pred));
+            true
+        }
         (C::Capsule(x), _) if as_polyhedron(b).is_some() => {
             let pb = as_polyhedron(b).expect("checked");
-            full(capsule_polyhedron_manifold(x, b, &pb, pose_ab, pred))
+            out.extend(capsule_polyhedron_manifold(x, b, &pb, pose_ab, pred));
+            true
         }
-        (_, C::Capsule(_)) if as_polyhedron(a).is_some() => swap(
-            convex_convex(b, a, &pose_ab.inverse(), cfg, want_full),
-            pose_ab,
-        ),
+        (_, C::Capsule(_)) if as_polyhedron(a).is_some() => swapped(out),
         _ => match (as_polyhedron(a), as_polyhedron(b)) {
-            (Some(pa), Some(pb)) => full(polyhedron_manifold(&pa, &pb, pose_ab, pred)),
-            _ if matches!(a, C::Triangle(_)) => {
-                // Perturb the shape, not the triangle (whose origin is the mesh's).
-                swap(
-                    convex_convex(b, a, &pose_ab.inverse(), cfg, want_full),
-                    pose_ab,
-                )
+            (Some(pa), Some(pb)) => {
+                if pa.flat || pb.flat || pa.edges().len() * pb.edges().len() <= SAT_MAX_EDGE_PAIRS {
+                    polyhedron_manifold_into(&pa, &pb, pose_ab, pred, out);
+                } else {
+                    polyhedron_manifold_guided(&pa, &pb, a, b, pose_ab, pred, out);
+                }
+                true
             }
+            // Perturb the shape, not the triangle (whose origin is the mesh's).
+            _ if matches!(a, C::Triangle(_)) => swapped(out),
             _ => {
                 let f = |p: &Isometry| contact_convex(a, b, p, pred);
                 let Some(c0) = f(pose_ab) else {
-                    return Generated::default();
+                    return false;
                 };
-                let mut contacts = vec![(c0, NO_FEATURE)];
+                out.push((c0, NO_FEATURE));
                 if want_full {
                     let more = perturbed_contacts(
                         &f,
@@ -126,16 +155,13 @@ pub fn convex_convex(
                         cfg.perturbation_angle,
                         cfg.perturbation_iterations,
                     );
-                    contacts.extend(
+                    out.extend(
                         more.into_iter()
                             .filter(|c| c.distance <= pred)
                             .map(|c| (c, NO_FEATURE)),
                     );
                 }
-                Generated {
-                    contacts,
-                    full: false,
-                }
+                false
             }
         },
     }
@@ -164,7 +190,10 @@ pub fn plane_convex(
             full: true,
         },
         ConvexRef::Sphere(_) => Generated {
-            contacts: single(contact_plane_convex(plane, b, pose_ab, pred)),
+            contacts: contact_plane_convex(plane, b, pose_ab, pred)
+                .map(|c| (c, NO_FEATURE))
+                .into_iter()
+                .collect(),
             full: true,
         },
         _ => {
@@ -200,14 +229,20 @@ pub fn plane_convex(
 }
 
 /// True when the built-in table handles shapes `a` and `b` (recursing into compounds).
+/// Triangle meshes, heightfields and planes need a convex partner (or a compound of
+/// convex shapes).
 pub fn supported(a: &Shape, b: &Shape) -> bool {
+    let surface = |s: &Shape| {
+        matches!(
+            s,
+            Shape::Plane(_) | Shape::TriMesh(_) | Shape::HeightField(_)
+        )
+    };
     match (a, b) {
         (Shape::Compound(c), o) | (o, Shape::Compound(c)) => {
             c.children().iter().all(|(_, s)| supported(s, o))
         }
-        (Shape::Plane(_), Shape::Plane(_) | Shape::TriMesh(_))
-        | (Shape::TriMesh(_), Shape::Plane(_) | Shape::TriMesh(_)) => false,
-        _ => true,
+        _ => !(surface(a) && surface(b)),
     }
 }
 
@@ -220,56 +255,83 @@ pub fn generate(
     cfg: &ManifoldConfig,
     want_full: bool,
 ) -> Result<Generated> {
+    let mut contacts = Vec::new();
+    let full = generate_into(a, b, pose_ab, cfg, want_full, &mut contacts)?;
+    Ok(Generated { contacts, full })
+}
+
+/// Contacts of triangles (mesh or heightfield) A against convex B, appended to `out`.
+fn triangles_convex_into<M: ContactTriangles>(
+    m: &M,
+    cb: ConvexRef<'_>,
+    pose_ab: &Isometry,
+    cfg: &ManifoldConfig,
+    want_full: bool,
+    out: &mut ContactList,
+) -> bool {
+    // Shapes without one-shot manifolds (cylinders, cones, scaled shapes) use the hybrid
+    // method: perturbation when the cache is empty, single points after.
+    let incremental =
+        as_polyhedron(cb).is_none() && !matches!(cb, ConvexRef::Sphere(_) | ConvexRef::Capsule(_));
+    let full = want_full && incremental;
+    let mut tri_contacts = |t: &Triangle, out: &mut ContactList| {
+        convex_convex_into(ConvexRef::Triangle(t), cb, pose_ab, cfg, full, out);
+    };
+    mesh_convex_contacts(m, cb, pose_ab, cfg.prediction, &mut tri_contacts, out);
+    !incremental
+}
+
+/// [`generate`] appending to `out`; returns whether the contacts form a full manifold.
+pub fn generate_into(
+    a: &Shape,
+    b: &Shape,
+    pose_ab: &Isometry,
+    cfg: &ManifoldConfig,
+    want_full: bool,
+    out: &mut ContactList,
+) -> Result<bool> {
     if let (Some(ca), Some(cb)) = (a.as_convex(), b.as_convex()) {
-        return Ok(convex_convex(ca, cb, pose_ab, cfg, want_full));
+        return Ok(convex_convex_into(ca, cb, pose_ab, cfg, want_full, out));
     }
-    let reversed = |g: Result<Generated>| g.map(|g| swap(g, pose_ab));
+    let reversed = |out: &mut ContactList| -> Result<bool> {
+        let start = out.len();
+        let full = generate_into(b, a, &pose_ab.inverse(), cfg, want_full, out)?;
+        swap_from(out, start, pose_ab);
+        Ok(full)
+    };
     match (a, b) {
         (Shape::Compound(c), _) => {
             let b_box = b.aabb(pose_ab).expanded(cfg.prediction.max(0.0));
-            let mut contacts = Vec::new();
             for (i, (child_pose, child)) in c.children().iter().enumerate() {
                 if !child.aabb(child_pose).intersects(&b_box) {
                     continue;
                 }
                 let pose_cb = child_pose.inv_mul(pose_ab);
-                let g = generate(child, b, &pose_cb, cfg, true)?;
-                contacts.extend(
-                    g.contacts
-                        .into_iter()
-                        .map(|(k, id)| (k.transformed(child_pose), mix_feature(i as u32, id))),
-                );
+                let start = out.len();
+                generate_into(child, b, &pose_cb, cfg, true, out)?;
+                for (k, id) in &mut out[start..] {
+                    *k = k.transformed(child_pose);
+                    *id = mix_feature(i as u32, *id);
+                }
             }
-            Ok(Generated {
-                contacts,
-                full: true,
-            })
+            Ok(true)
         }
-        (_, Shape::Compound(_)) => reversed(generate(b, a, &pose_ab.inverse(), cfg, want_full)),
-        (Shape::Plane(p), _) if b.is_convex() => Ok(plane_convex(
-            p,
-            b.as_convex().expect("checked"),
-            pose_ab,
-            cfg,
-            want_full,
-        )),
+        (_, Shape::Compound(_)) => reversed(out),
+        (Shape::Plane(p), _) if b.is_convex() => {
+            let g = plane_convex(p, b.as_convex().expect("checked"), pose_ab, cfg, want_full);
+            out.extend(g.contacts);
+            Ok(g.full)
+        }
         (Shape::TriMesh(m), _) if b.is_convex() => {
             let cb = b.as_convex().expect("checked");
-            // Shapes without one-shot manifolds (cylinders, cones, scaled shapes) use the
-            // hybrid method: perturbation when the cache is empty, single points after.
-            let incremental = as_polyhedron(cb).is_none()
-                && !matches!(cb, ConvexRef::Sphere(_) | ConvexRef::Capsule(_));
-            let tri_contacts = |t: &crate::shape::Triangle| {
-                let full = want_full && incremental;
-                convex_convex(ConvexRef::Triangle(t), cb, pose_ab, cfg, full).contacts
-            };
-            Ok(Generated {
-                contacts: mesh_convex_contacts(m, cb, pose_ab, cfg.prediction, &tri_contacts),
-                full: !incremental,
-            })
+            Ok(triangles_convex_into(m, cb, pose_ab, cfg, want_full, out))
         }
-        (_, Shape::Plane(_) | Shape::TriMesh(_)) if a.is_convex() => {
-            reversed(generate(b, a, &pose_ab.inverse(), cfg, want_full))
+        (Shape::HeightField(h), _) if b.is_convex() => {
+            let cb = b.as_convex().expect("checked");
+            Ok(triangles_convex_into(h, cb, pose_ab, cfg, want_full, out))
+        }
+        (_, Shape::Plane(_) | Shape::TriMesh(_) | Shape::HeightField(_)) if a.is_convex() => {
+            reversed(out)
         }
         _ => Err(unsupported(a, b)),
     }
@@ -318,19 +380,43 @@ impl Dispatcher {
         pose_ab: &Isometry,
         want_full: bool,
     ) -> Result<Generated> {
+        let mut contacts = Vec::new();
+        let full = self.generate_into(a, b, pose_ab, want_full, &mut contacts)?;
+        Ok(Generated { contacts, full })
+    }
+
+    /// [`Dispatcher::generate`] appending to `out` (reusing its capacity); returns whether
+    /// the contacts form a full manifold.
+    pub fn generate_into(
+        &self,
+        a: &Shape,
+        b: &Shape,
+        pose_ab: &Isometry,
+        want_full: bool,
+        out: &mut ContactList,
+    ) -> Result<bool> {
         let (ka, kb) = (a.kind(), b.kind());
         if let Some(f) = self.user.get(&(ka, kb)) {
-            return Ok(f(a, b, pose_ab, &self.config, want_full));
+            let g = f(a, b, pose_ab, &self.config, want_full);
+            out.extend(g.contacts);
+            return Ok(g.full);
         }
         if let Some(f) = self.user.get(&(kb, ka)) {
-            let pose_ba = pose_ab.inverse();
-            return Ok(swap(f(b, a, &pose_ba, &self.config, want_full), pose_ab));
+            let g = swap(
+                f(b, a, &pose_ab.inverse(), &self.config, want_full),
+                pose_ab,
+            );
+            out.extend(g.contacts);
+            return Ok(g.full);
         }
-        generate(a, b, pose_ab, &self.config, want_full)
+        generate_into(a, b, pose_ab, &self.config, want_full, out)
     }
 
     /// One step of the persistent manifold: refresh from the poses, generate, then replace
-    /// (full manifolds) or add point by point (the hybrid method).
+    /// (full manifolds) or add point by point (the hybrid method). Works in per-thread
+    /// scratch buffers: no heap allocation in the steady state for polyhedra and spheres.
+    /// While the relative pose stays within the coherence tolerances of the last full
+    /// generation ([`ContactManifold::is_coherent`]), the refreshed points are kept as they are.
     pub fn update_manifold(
         &self,
         a: &Shape,
@@ -339,22 +425,42 @@ impl Dispatcher {
         pose_b: &Isometry,
         manifold: &mut ContactManifold,
     ) -> Result<()> {
+        thread_local! {
+            static SCRATCH: RefCell<(ContactList, Vec<ContactPoint>)> =
+                const { RefCell::new((Vec::new(), Vec::new())) };
+        }
         let cfg = &self.config;
+        let before = manifold.len();
         manifold.refresh(pose_a, pose_b, cfg.breaking_threshold);
         let pose_ab = pose_a.inv_mul(pose_b);
-        let g = self.generate(a, b, &pose_ab, manifold.is_empty())?;
-        let pts: Vec<ContactPoint> = g
-            .contacts
-            .iter()
-            .map(|(c, id)| ContactPoint::from_local_contact(c, pose_a, pose_b, *id))
-            .collect();
-        if g.full {
-            manifold.replace_all(pts, cfg.merge_distance);
-        } else {
-            for p in pts {
-                manifold.add_point(p, cfg.merge_distance);
-            }
+        if manifold.len() == before && manifold.is_coherent(&pose_ab) {
+            return Ok(());
         }
-        Ok(())
+        SCRATCH.with(|cell| {
+            // A re-entrant call (a user algorithm updating another manifold) gets fresh buffers.
+            let mut fresh = Default::default();
+            let mut guard = cell.try_borrow_mut();
+            let (contacts, pts) = match guard.as_deref_mut() {
+                Ok(s) => s,
+                Err(_) => &mut fresh,
+            };
+            contacts.clear();
+            pts.clear();
+            let full = self.generate_into(a, b, &pose_ab, manifold.is_empty(), contacts)?;
+            pts.extend(
+                contacts
+                    .iter()
+                    .map(|(c, id)| ContactPoint::from_local_contact(c, pose_a, pose_b, *id)),
+            );
+            manifold.generated_at = full.then_some(pose_ab);
+            if full {
+                manifold.replace_with(pts, cfg.merge_distance);
+            } else {
+                for p in pts.drain(..) {
+                    manifold.add_point(p, cfg.merge_distance);
+                }
+            }
+            Ok(())
+        })
     }
 }

@@ -46,7 +46,21 @@ impl Default for ManifoldConfig {
 pub struct ContactManifold {
     /// The points, in insertion order (stable across steps while they persist).
     pub points: Vec<ContactPoint>,
+    /// The relative pose (B in A's frame) at which the points were last generated as a full
+    /// one-shot manifold, or `None` (incremental points, or never): while the pose stays
+    /// within [`COHERENCE_ANGLE`] and [`COHERENCE_DISTANCE`] of it, the refreshed points are
+    /// kept without running contact generation again (spatial coherence, as Bullet's contact
+    /// caching and parry's `try_update_contacts`).
+    #[serde(default)]
+    pub generated_at: Option<Isometry>,
 }
+
+/// Relative rotation (radians) under which a manifold's points are reused unchanged.
+pub const COHERENCE_ANGLE: Real = 1.0 * crate::math::consts::PI / 180.0;
+
+/// Relative displacement (length units) of every contact point under which a manifold's
+/// points are reused unchanged.
+pub const COHERENCE_DISTANCE: Real = 1.0e-3;
 
 impl ContactManifold {
     /// An empty manifold.
@@ -67,6 +81,28 @@ impl ContactManifold {
     /// Removes every point.
     pub fn clear(&mut self) {
         self.points.clear();
+        self.generated_at = None;
+    }
+
+    /// True when the manifold holds a full manifold generated at a relative pose within
+    /// [`COHERENCE_ANGLE`] of `pose_ab`'s rotation and whose points moved less than
+    /// [`COHERENCE_DISTANCE`] since (so generating again would give the same points).
+    pub fn is_coherent(&self, pose_ab: &Isometry) -> bool {
+        let Some(p0) = self.generated_at else {
+            return false;
+        };
+        if self.points.is_empty() {
+            return false;
+        }
+        let cos_half = (0.5 * COHERENCE_ANGLE).cos();
+        if p0.rotation.dot(pose_ab.rotation).abs() < cos_half {
+            return false;
+        }
+        let tol2 = COHERENCE_DISTANCE * COHERENCE_DISTANCE;
+        self.points.iter().all(|p| {
+            let d = pose_ab.transform_point(p.local_b) - p0.transform_point(p.local_b);
+            d.length_squared() <= tol2
+        })
     }
 
     /// The deepest (smallest) distance, or `None` when empty.
@@ -143,6 +179,12 @@ impl ContactManifold {
     /// Replaces the whole manifold by a freshly generated full one (the one-shot half of the
     /// hybrid method), carrying impulses and lifetimes over from matching cached points.
     pub fn replace_all(&mut self, mut new_points: Vec<ContactPoint>, merge_distance: Real) {
+        self.replace_with(&mut new_points, merge_distance);
+    }
+
+    /// [`ContactManifold::replace_all`] without allocating: the points are taken from
+    /// `new_points`, which receives the old points' buffer (cleared) for reuse.
+    pub fn replace_with(&mut self, new_points: &mut Vec<ContactPoint>, merge_distance: Real) {
         new_points.retain(|p| p.is_finite());
         for p in new_points.iter_mut() {
             if let Some(i) = self.find_match(p, merge_distance) {
@@ -152,7 +194,8 @@ impl ContactManifold {
                 p.lifetime = old.lifetime;
             }
         }
-        self.points = new_points;
+        std::mem::swap(&mut self.points, new_points);
+        new_points.clear();
         if self.points.len() > MAX_MANIFOLD_POINTS {
             self.reduce();
         }
@@ -175,7 +218,7 @@ impl ContactManifold {
         }
         let n = pts[i0].normal;
         let proj = |v: Vec3| v - n * v.dot(n);
-        let q: Vec<Vec3> = pts.iter().map(|p| proj(p.point_b)).collect();
+        let q: smallvec::SmallVec<[Vec3; 16]> = pts.iter().map(|p| proj(p.point_b)).collect();
         let argmax = |f: &dyn Fn(usize) -> Real| -> usize {
             let mut best = 0;
             let mut best_v = Real::NEG_INFINITY;
@@ -216,9 +259,17 @@ impl ContactManifold {
                 .map(|&(u, v)| -(q[v] - q[u]).cross(q[i] - q[u]).dot(n))
                 .fold(Real::NEG_INFINITY, Real::max)
         });
-        let mut keep = vec![i0, i1, i2, i3];
+        let mut keep = [i0, i1, i2, i3];
         keep.sort_unstable();
-        keep.dedup();
-        self.points = keep.into_iter().map(|i| pts[i]).collect();
+        let mut kept = [pts[0]; MAX_MANIFOLD_POINTS];
+        let mut n = 0;
+        for (k, &i) in keep.iter().enumerate() {
+            if k == 0 || keep[k - 1] != i {
+                kept[n] = pts[i];
+                n += 1;
+            }
+        }
+        self.points.clear();
+        self.points.extend_from_slice(&kept[..n]);
     }
 }

@@ -1,6 +1,7 @@
-//! Convex shapes against triangle meshes and compounds: the midphase finds the triangles
-//! (or children) overlapping the convex's box, each gives contacts, merged into one
-//! manifold (reduced by [`super::ContactManifold::replace_all`]).
+//! Convex shapes against triangle meshes, heightfields and compounds: the midphase finds the
+//! triangles (mesh BVH or heightfield grid, see [`ContactTriangles`]) or children overlapping
+//! the convex's box, each gives contacts, merged into one manifold (reduced by
+//! [`super::ContactManifold::replace_all`]).
 //!
 //! Internal-edge correction (Coumans, "Contact Generation", "Internal edges and contact
 //! normals"; Bullet's `btInternalEdgeUtility`, Jolt's active edges, Box3D's mesh edge flags):
@@ -9,11 +10,60 @@
 //! concave edges (and the face interior) it becomes the face normal, on real convex edges
 //! it may turn up to the dihedral angle.
 
-use super::contact::FeatureId;
+use super::contact::{ContactList, FeatureId};
+use crate::math::Aabb;
 use crate::math::{Isometry, Real, Vec3};
 use crate::query::closest_points::closest_point_segment;
 use crate::query::Contact;
-use crate::shape::{ConvexRef, EdgeKind, SupportMap, TriMesh, Triangle};
+use crate::shape::{ConvexRef, EdgeKind, HeightField, MeshEdge, SupportMap, TriMesh, Triangle};
+use smallvec::SmallVec;
+
+/// A triangle soup with a midphase and precomputed (or derivable) edge convexity: what
+/// convex-vs-triangles contact generation needs. Implemented by [`TriMesh`] (BVH, edges
+/// computed at construction) and [`HeightField`] (grid cells, edges from the grid).
+pub trait ContactTriangles {
+    /// Calls `f` with every triangle whose box overlaps `aabb` (local frame), in a
+    /// deterministic order.
+    fn for_each_candidate(&self, aabb: &Aabb, f: &mut dyn FnMut(u32));
+    /// The corners of triangle `t`.
+    fn corners(&self, t: u32) -> [Vec3; 3];
+    /// Adjacency and convexity of the edges of triangle `t`.
+    fn triangle_edges(&self, t: u32) -> [MeshEdge; 3];
+}
+
+impl ContactTriangles for TriMesh {
+    fn for_each_candidate(&self, aabb: &Aabb, f: &mut dyn FnMut(u32)) {
+        self.view().for_each_triangle_in_aabb(aabb, |t| {
+            f(t);
+            true
+        });
+    }
+    #[inline]
+    fn corners(&self, t: u32) -> [Vec3; 3] {
+        self.triangle(t as usize)
+    }
+    #[inline]
+    fn triangle_edges(&self, t: u32) -> [MeshEdge; 3] {
+        self.edges()[t as usize]
+    }
+}
+
+impl ContactTriangles for HeightField {
+    fn for_each_candidate(&self, aabb: &Aabb, f: &mut dyn FnMut(u32)) {
+        self.for_each_triangle_in_aabb(aabb, |t| {
+            f(t);
+            true
+        });
+    }
+    #[inline]
+    fn corners(&self, t: u32) -> [Vec3; 3] {
+        self.triangle(t as usize)
+    }
+    #[inline]
+    fn triangle_edges(&self, t: u32) -> [MeshEdge; 3] {
+        HeightField::triangle_edges(self, t as usize)
+    }
+}
 
 /// World (here: mesh-frame) box of convex `b` at `pose_ab`, from six support queries.
 pub fn convex_aabb(b: ConvexRef<'_>, pose_ab: &Isometry) -> crate::math::Aabb {
@@ -34,11 +84,11 @@ pub fn mix_feature(index: u32, id: FeatureId) -> FeatureId {
     index.wrapping_mul(0x9E37_79B1) ^ id
 }
 
-/// Applies internal-edge correction to contact `c` (mesh frame, normal from triangle `t`
-/// towards `b`, `point_a` on the triangle). Returns true when the normal was changed.
+/// Applies internal-edge correction to contact `c` (mesh frame, normal from triangle `tri`
+/// with edges `edges` towards `b`, `point_a` on the triangle). Returns true when the normal
+/// was changed.
 pub fn correct_internal_edge(
-    mesh: &TriMesh,
-    t: usize,
+    edges: &[MeshEdge; 3],
     tri: &Triangle,
     b: ConvexRef<'_>,
     pose_ab: &Isometry,
@@ -58,7 +108,6 @@ pub fn correct_internal_edge(
         .max((v[2] - v[1]).length())
         .max((v[0] - v[2]).length());
     let tol = 1.0e-3 * scale + 1.0e-5;
-    let edges = &mesh.edges()[t];
     for k in 0..3 {
         let (p, q) = (v[k], v[(k + 1) % 3]);
         let (_, d) = closest_point_segment(c.point_a, p, q);
@@ -88,31 +137,44 @@ pub fn correct_internal_edge(
     true
 }
 
-/// Contacts of mesh A against convex B at `pose_ab` (mesh frame, query convention).
-/// `tri_contacts` gives the contacts of one triangle against B.
-pub fn mesh_convex_contacts(
-    mesh: &TriMesh,
+/// Contacts of triangles A (a mesh or heightfield) against convex B at `pose_ab` (A's frame,
+/// query convention), appended to `out`. `tri_contacts` appends the contacts of one
+/// triangle against B; each is then corrected for internal edges.
+pub fn mesh_convex_contacts<M: ContactTriangles + ?Sized>(
+    mesh: &M,
     b: ConvexRef<'_>,
     pose_ab: &Isometry,
     prediction: Real,
-    tri_contacts: &dyn Fn(&Triangle) -> Vec<(Contact, FeatureId)>,
-) -> Vec<(Contact, FeatureId)> {
+    tri_contacts: &mut dyn FnMut(&Triangle, &mut ContactList),
+    out: &mut ContactList,
+) {
     let aabb = convex_aabb(b, pose_ab).expanded(prediction.max(0.0));
-    let mut out = Vec::new();
-    for t in mesh.overlapping_triangles(&aabb) {
-        let [p, q, r] = mesh.triangle(t as usize);
-        let Ok(tri) = Triangle::new(p, q, r) else {
-            continue;
-        };
-        if tri.normal().is_none() {
+    // Triangles in index order, so a mesh and a heightfield with the same triangles give
+    // the same sequence of points (and the same reduced manifold).
+    let mut tris: SmallVec<[u32; 64]> = SmallVec::new();
+    mesh.for_each_candidate(&aabb, &mut |t| tris.push(t));
+    tris.sort_unstable();
+    for t in tris {
+        let [p, q, r] = mesh.corners(t);
+        let tri = Triangle { a: p, b: q, c: r };
+        if tri.normal().is_none() || !tri.vertices().iter().all(|v| v.is_finite()) {
             continue;
         }
-        for (mut c, id) in tri_contacts(&tri) {
-            correct_internal_edge(mesh, t as usize, &tri, b, pose_ab, &mut c);
+        let start = out.len();
+        tri_contacts(&tri, out);
+        if out.len() == start {
+            continue;
+        }
+        let edges = mesh.triangle_edges(t);
+        let mut keep = start;
+        for i in start..out.len() {
+            let (mut c, id) = out[i];
+            correct_internal_edge(&edges, &tri, b, pose_ab, &mut c);
             if c.distance <= prediction && c.distance.is_finite() && c.normal.is_finite() {
-                out.push((c, mix_feature(t, id)));
+                out[keep] = (c, mix_feature(t, id));
+                keep += 1;
             }
         }
+        out.truncate(keep);
     }
-    out
 }

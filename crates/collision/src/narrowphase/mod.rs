@@ -11,8 +11,10 @@
 pub mod contact;
 pub mod manifold;
 
-pub use contact::{ContactPoint, FeatureId, NO_FEATURE};
-pub use manifold::{ContactManifold, ManifoldConfig, MAX_MANIFOLD_POINTS};
+pub use contact::{ContactList, ContactPoint, FeatureId, NO_FEATURE};
+pub use manifold::{
+    ContactManifold, ManifoldConfig, COHERENCE_ANGLE, COHERENCE_DISTANCE, MAX_MANIFOLD_POINTS,
+};
 pub mod convex;
 pub mod dispatcher;
 pub mod mesh;

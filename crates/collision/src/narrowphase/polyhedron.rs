@@ -8,122 +8,199 @@
 use super::contact::FeatureId;
 use crate::math::{Isometry, Real, Vec3};
 use crate::query::closest_points::closest_points_segment_segment;
-use crate::query::Contact;
-use crate::shape::{ConvexHull, Cuboid, Triangle};
+use crate::query::{contact_convex, Contact};
+use crate::shape::convex_hull::edge_face_pairs;
+use crate::shape::{ConvexHull, ConvexRef, Cuboid, HullFace, Triangle};
+use smallvec::SmallVec;
+use std::sync::OnceLock;
+
+/// Scratch arrays of transformed vertices or normals: on the stack up to 64 entries.
+type Buf = SmallVec<[Vec3; 64]>;
+
+/// Borrowed (hulls) or inline (boxes, triangles) storage, so that building a view never
+/// allocates.
+#[derive(Debug, Clone, Copy)]
+enum Store<'a, T: Copy, const N: usize> {
+    Borrowed(&'a [T]),
+    Inline([T; N], usize),
+}
+
+impl<T: Copy, const N: usize> std::ops::Deref for Store<'_, T, N> {
+    type Target = [T];
+    #[inline]
+    fn deref(&self) -> &[T] {
+        match self {
+            Store::Borrowed(s) => s,
+            Store::Inline(a, n) => &a[..*n],
+        }
+    }
+}
 
 /// A convex polyhedron view: vertices, faces (plane + counter-clockwise vertex loop) and
 /// edges with their two adjacent faces (for the Gauss map).
-#[derive(Debug, Clone, Default)]
-pub struct Polyhedron {
-    /// Vertices.
-    pub vertices: Vec<Vec3>,
-    /// Faces: unit outward normal, plane offset, range in `loops`.
-    pub faces: Vec<(Vec3, Real, u32, u32)>,
-    /// Concatenated counter-clockwise vertex loops of the faces.
-    pub loops: Vec<u32>,
-    /// Edges: two vertex indices and the two adjacent faces.
-    pub edges: Vec<[u32; 4]>,
+///
+/// The view never allocates: a hull lends its precomputed faces and edge adjacency
+/// ([`ConvexHull::edge_faces`]); a box or a triangle keeps its few vertices and planes inline
+/// and shares a static topology.
+#[derive(Debug, Clone, Copy)]
+pub struct Polyhedron<'a> {
+    vertices: Store<'a, Vec3, 8>,
+    faces: Store<'a, HullFace, 6>,
+    loops: &'a [u32],
+    edges: &'a [[u32; 2]],
+    edge_faces: &'a [[u32; 2]],
     /// True for a flat polygon (a triangle): its edges' Gauss arcs are half circles and
     /// are never pruned.
     pub flat: bool,
 }
 
-impl Polyhedron {
-    /// The loop of face `f`.
-    pub fn face_loop(&self, f: usize) -> &[u32] {
-        let (_, _, s, c) = self.faces[f];
-        &self.loops[s as usize..(s + c) as usize]
+/// Corner `i` of a box has coordinate signs from bits 0 (x), 1 (y), 2 (z).
+const BOX_LOOPS: [u32; 24] = [
+    1, 3, 7, 5, 0, 4, 6, 2, 2, 6, 7, 3, 0, 1, 5, 4, 4, 5, 7, 6, 0, 2, 3, 1,
+];
+const BOX_EDGES: [[u32; 2]; 12] = [
+    [0, 1],
+    [0, 2],
+    [0, 4],
+    [1, 3],
+    [1, 5],
+    [2, 3],
+    [2, 6],
+    [3, 7],
+    [4, 5],
+    [4, 6],
+    [5, 7],
+    [6, 7],
+];
+const TRI_LOOPS: [u32; 6] = [0, 1, 2, 0, 2, 1];
+const TRI_EDGES: [[u32; 2]; 3] = [[0, 1], [0, 2], [1, 2]];
+const TRI_EDGE_FACES: [[u32; 2]; 3] = [[0, 1], [1, 0], [0, 1]];
+
+/// The box's edge adjacency, derived once from its face loops.
+fn box_edge_faces() -> &'static [[u32; 2]] {
+    static CELL: OnceLock<Vec<[u32; 2]>> = OnceLock::new();
+    CELL.get_or_init(|| {
+        let directed = (0..6)
+            .flat_map(|f| {
+                let lp = &BOX_LOOPS[4 * f..4 * f + 4];
+                (0..4).map(move |k| ([lp[k], lp[(k + 1) % 4]], f as u32))
+            })
+            .collect();
+        edge_face_pairs(&BOX_EDGES, directed)
+    })
+}
+
+impl<'a> Polyhedron<'a> {
+    /// The vertices.
+    #[inline]
+    pub fn vertices(&self) -> &[Vec3] {
+        &self.vertices
     }
 
-    fn from_loops(vertices: Vec<Vec3>, loops: &[Vec<u32>], flat: bool) -> Polyhedron {
-        let mut p = Polyhedron {
-            vertices,
-            flat,
-            ..Default::default()
-        };
-        let mut directed: Vec<(u32, u32, u32)> = Vec::new();
-        for (fi, lp) in loops.iter().enumerate() {
-            let v = &p.vertices;
-            let mut n = Vec3::ZERO;
-            for k in 0..lp.len() {
-                let a = v[lp[k] as usize];
-                let b = v[lp[(k + 1) % lp.len()] as usize];
-                n += a.cross(b);
-            }
-            let n = n.normalize_or_zero();
-            let off = n.dot(v[lp[0] as usize]);
-            p.faces
-                .push((n, off, p.loops.len() as u32, lp.len() as u32));
-            p.loops.extend_from_slice(lp);
-            for k in 0..lp.len() {
-                directed.push((lp[k], lp[(k + 1) % lp.len()], fi as u32));
-            }
-        }
-        // Pair each directed edge i→j with its twin j→i.
-        directed.sort_unstable();
-        for &(i, j, f) in &directed {
-            if i < j {
-                if let Ok(t) = directed.binary_search_by(|e| (e.0, e.1).cmp(&(j, i))) {
-                    p.edges.push([i, j, f, directed[t].2]);
-                }
-            }
-        }
-        p
+    /// The faces (unit outward normal, plane offset, range of the loop).
+    #[inline]
+    pub fn faces(&self) -> &[HullFace] {
+        &self.faces
+    }
+
+    /// The edges (vertex pairs).
+    #[inline]
+    pub fn edges(&self) -> &[[u32; 2]] {
+        self.edges
+    }
+
+    /// The loop of face `f`.
+    #[inline]
+    pub fn face_loop(&self, f: usize) -> &[u32] {
+        let h = &self.faces[f];
+        &self.loops[h.first as usize..(h.first + h.count) as usize]
     }
 
     /// The box as a polyhedron (its exact half extents, margin ignored).
-    pub fn from_cuboid(b: &Cuboid) -> Polyhedron {
+    pub fn from_cuboid(b: &Cuboid) -> Polyhedron<'static> {
         let h = b.half_extents();
-        let vertices: Vec<Vec3> = (0..8)
-            .map(|i| {
-                Vec3::new(
-                    if i & 1 != 0 { h.x } else { -h.x },
-                    if i & 2 != 0 { h.y } else { -h.y },
-                    if i & 4 != 0 { h.z } else { -h.z },
-                )
-            })
-            .collect();
-        let loops = [
-            vec![1, 3, 7, 5],
-            vec![0, 4, 6, 2],
-            vec![2, 6, 7, 3],
-            vec![0, 1, 5, 4],
-            vec![4, 5, 7, 6],
-            vec![0, 2, 3, 1],
-        ];
-        Self::from_loops(vertices, &loops, false)
+        let corner = |i: usize| {
+            Vec3::new(
+                if i & 1 != 0 { h.x } else { -h.x },
+                if i & 2 != 0 { h.y } else { -h.y },
+                if i & 4 != 0 { h.z } else { -h.z },
+            )
+        };
+        let face = |i: usize| {
+            let mut normal = Vec3::ZERO;
+            normal[i / 2] = if i.is_multiple_of(2) { 1.0 } else { -1.0 };
+            HullFace {
+                normal,
+                offset: h[i / 2],
+                first: 4 * i as u32,
+                count: 4,
+            }
+        };
+        Polyhedron {
+            vertices: Store::Inline(std::array::from_fn(corner), 8),
+            faces: Store::Inline(std::array::from_fn(face), 6),
+            loops: &BOX_LOOPS,
+            edges: &BOX_EDGES,
+            edge_faces: box_edge_faces(),
+            flat: false,
+        }
     }
 
-    /// The hull as a polyhedron.
-    pub fn from_hull(h: &ConvexHull) -> Polyhedron {
-        let loops: Vec<Vec<u32>> = (0..h.faces().len())
-            .map(|f| h.face_vertices(f).to_vec())
-            .collect();
-        Self::from_loops(h.vertices().to_vec(), &loops, false)
+    /// The hull as a polyhedron (borrows the hull's faces and edge adjacency).
+    pub fn from_hull(h: &'a ConvexHull) -> Polyhedron<'a> {
+        Polyhedron {
+            vertices: Store::Borrowed(h.vertices()),
+            faces: Store::Borrowed(h.faces()),
+            loops: h.face_vertex_indices(),
+            edges: h.edges(),
+            edge_faces: h.edge_faces(),
+            flat: false,
+        }
     }
 
     /// The triangle as a flat polyhedron with a front and a back face.
-    pub fn from_triangle(t: &Triangle) -> Polyhedron {
-        Self::from_loops(t.vertices().to_vec(), &[vec![0, 1, 2], vec![0, 2, 1]], true)
-    }
-
-    fn support_dot(&self, pose: &Isometry, dir: Vec3) -> Real {
-        let d = pose.inverse_transform_vector(dir);
-        let m = self
-            .vertices
-            .iter()
-            .map(|v| v.dot(d))
-            .fold(Real::NEG_INFINITY, Real::max);
-        m + pose.translation.dot(dir)
+    pub fn from_triangle(t: &Triangle) -> Polyhedron<'static> {
+        let n = t.scaled_normal().normalize_or_zero();
+        let off = n.dot(t.a);
+        let mut v = [Vec3::ZERO; 8];
+        v[..3].copy_from_slice(&t.vertices());
+        let mut f = [HullFace {
+            normal: n,
+            offset: off,
+            first: 0,
+            count: 3,
+        }; 6];
+        f[1] = HullFace {
+            normal: -n,
+            offset: -off,
+            first: 3,
+            count: 3,
+        };
+        Polyhedron {
+            vertices: Store::Inline(v, 3),
+            faces: Store::Inline(f, 2),
+            loops: &TRI_LOOPS,
+            edges: &TRI_EDGES,
+            edge_faces: &TRI_EDGE_FACES,
+            flat: true,
+        }
     }
 }
 
-/// Face query: the face of `a` (identity pose) with the greatest separation from `b` (at
-/// `pose_ab`).
-fn face_query(a: &Polyhedron, b: &Polyhedron, pose_ab: &Isometry) -> (Real, usize) {
+#[inline]
+fn max_dot(points: &[Vec3], dir: Vec3) -> Real {
+    points
+        .iter()
+        .map(|v| v.dot(dir))
+        .fold(Real::NEG_INFINITY, Real::max)
+}
+
+/// Face query: the face (given by normals and offsets in A's frame) with the greatest
+/// separation from the points `others` (the other shape's vertices in the same frame).
+fn face_query(normals: &[Vec3], offsets: &[Real], others: &[Vec3]) -> (Real, usize) {
     let mut best = (Real::NEG_INFINITY, 0);
-    for (i, &(n, off, _, _)) in a.faces.iter().enumerate() {
-        let s = -b.support_dot(pose_ab, -n) - off;
+    for (i, (&n, &off)) in normals.iter().zip(offsets).enumerate() {
+        let s = -max_dot(others, -n) - off;
         if s > best.0 {
             best = (s, i);
         }
@@ -132,6 +209,7 @@ fn face_query(a: &Polyhedron, b: &Polyhedron, pose_ab: &Isometry) -> (Real, usiz
 }
 
 /// Gregorius' Minkowski-face test: arcs AB and CD of the Gauss map intersect.
+#[inline]
 fn is_minkowski_face(a: Vec3, b: Vec3, c: Vec3, d: Vec3) -> bool {
     let bxa = b.cross(a);
     let dxc = d.cross(c);
@@ -143,33 +221,41 @@ fn is_minkowski_face(a: Vec3, b: Vec3, c: Vec3, d: Vec3) -> bool {
 }
 
 /// Edge query: the edge pair with the greatest separation among the pairs that build a
-/// face of the Minkowski difference.
-fn edge_query(a: &Polyhedron, b: &Polyhedron, pose_ab: &Isometry) -> (Real, usize, usize, Vec3) {
+/// face of the Minkowski difference. `vb` and `nb` are B's vertices and face normals in A's
+/// frame.
+fn edge_query(
+    a: &Polyhedron,
+    b: &Polyhedron,
+    vb: &[Vec3],
+    nb: &[Vec3],
+) -> (Real, usize, usize, Vec3) {
     let mut best = (Real::NEG_INFINITY, 0, 0, Vec3::ZERO);
-    let ident = Isometry::IDENTITY;
-    let a_centre =
-        a.vertices.iter().fold(Vec3::ZERO, |s, v| s + *v) / a.vertices.len().max(1) as Real;
-    for (i, ea) in a.edges.iter().enumerate() {
-        let (pa, qa) = (a.vertices[ea[0] as usize], a.vertices[ea[1] as usize]);
-        let (na0, na1) = (a.faces[ea[2] as usize].0, a.faces[ea[3] as usize].0);
-        for (j, eb) in b.edges.iter().enumerate() {
-            let pb = pose_ab.transform_point(b.vertices[eb[0] as usize]);
-            let qb = pose_ab.transform_point(b.vertices[eb[1] as usize]);
-            let nb0 = pose_ab.transform_vector(b.faces[eb[2] as usize].0);
-            let nb1 = pose_ab.transform_vector(b.faces[eb[3] as usize].0);
-            if !a.flat && !b.flat && !is_minkowski_face(na0, na1, -nb0, -nb1) {
+    let va = a.vertices();
+    let a_centre = va.iter().fold(Vec3::ZERO, |s, v| s + *v) / va.len().max(1) as Real;
+    let flat = a.flat || b.flat;
+    for (i, (ea, fa)) in a.edges.iter().zip(a.edge_faces).enumerate() {
+        let (pa, qa) = (va[ea[0] as usize], va[ea[1] as usize]);
+        let (na0, na1) = (
+            a.faces[fa[0] as usize].normal,
+            a.faces[fa[1] as usize].normal,
+        );
+        let da = qa - pa;
+        for (j, (eb, fb)) in b.edges.iter().zip(b.edge_faces).enumerate() {
+            if !flat && !is_minkowski_face(na0, na1, -nb[fb[0] as usize], -nb[fb[1] as usize]) {
                 continue;
             }
-            let axis = (qa - pa).cross(qb - pb);
+            let (pb, qb) = (vb[eb[0] as usize], vb[eb[1] as usize]);
+            let db = qb - pb;
+            let axis = da.cross(db);
             let len = axis.length();
-            if len < 1.0e-5 * (qa - pa).length() * (qb - pb).length() || len == 0.0 {
+            if len < 1.0e-5 * da.length() * db.length() || len == 0.0 {
                 continue;
             }
             let axis = axis / len;
-            let (s, ax) = if a.flat || b.flat {
+            let (s, ax) = if flat {
                 // Flat polygons: exact separation along ±axis, keep the larger.
-                let s1 = -b.support_dot(pose_ab, -axis) - a.support_dot(&ident, axis);
-                let s2 = -b.support_dot(pose_ab, axis) - a.support_dot(&ident, -axis);
+                let s1 = -max_dot(vb, -axis) - max_dot(va, axis);
+                let s2 = -max_dot(vb, axis) - max_dot(va, -axis);
                 if s1 >= s2 {
                     (s1, axis)
                 } else {
@@ -193,9 +279,12 @@ fn edge_query(a: &Polyhedron, b: &Polyhedron, pose_ab: &Isometry) -> (Real, usiz
     best
 }
 
+/// A polygon being clipped: points with feature ids, on the stack up to 16 corners.
+type Poly = SmallVec<[(Vec3, u32); 16]>;
+
 /// Clips the polygon `poly` (points with feature ids) against the half-space
 /// `n · x <= d`; new points get id `(start id & 0xFFFF_FF00) | tag`.
-fn clip(poly: &[(Vec3, u32)], n: Vec3, d: Real, tag: u32, out: &mut Vec<(Vec3, u32)>) {
+fn clip(poly: &[(Vec3, u32)], n: Vec3, d: Real, tag: u32, out: &mut Poly) {
     out.clear();
     for k in 0..poly.len() {
         let (p, ip) = poly[k];
@@ -212,8 +301,8 @@ fn clip(poly: &[(Vec3, u32)], n: Vec3, d: Real, tag: u32, out: &mut Vec<(Vec3, u
 }
 
 /// Clips the incident face of `inc` (at `pose_ri` in the reference frame) against the side
-/// planes of face `rf` of `refp`; returns contacts in the reference frame (normal from the
-/// reference towards the incident shape).
+/// planes of face `rf` of `refp`; appends contacts in the reference frame (normal from the
+/// reference towards the incident shape) to `out`.
 fn clip_faces(
     refp: &Polyhedron,
     rf: usize,
@@ -221,35 +310,42 @@ fn clip_faces(
     pose_ri: &Isometry,
     prediction: Real,
     id_base: u32,
-) -> Vec<(Contact, FeatureId)> {
-    let (nr, off, _, _) = refp.faces[rf];
+    out: &mut impl Extend<(Contact, FeatureId)>,
+) {
+    let HullFace {
+        normal: nr,
+        offset: off,
+        ..
+    } = refp.faces[rf];
     let n_in_inc = pose_ri.inverse_transform_vector(nr);
     let mut inc_face = 0;
     let mut best = Real::INFINITY;
     for (i, f) in inc.faces.iter().enumerate() {
-        let d = f.0.dot(n_in_inc);
+        let d = f.normal.dot(n_in_inc);
         if d < best {
             best = d;
             inc_face = i;
         }
     }
     let id = id_base | ((inc_face as u32 & 0xFF) << 16);
-    let mut poly: Vec<(Vec3, u32)> = inc
+    let iv = inc.vertices();
+    let mut poly: Poly = inc
         .face_loop(inc_face)
         .iter()
         .enumerate()
         .map(|(k, &v)| {
             (
-                pose_ri.transform_point(inc.vertices[v as usize]),
+                pose_ri.transform_point(iv[v as usize]),
                 id | ((k as u32 & 0xFF) << 8) | 0xFF,
             )
         })
         .collect();
     let lp = refp.face_loop(rf);
-    let mut tmp = Vec::with_capacity(poly.len() + 4);
+    let rv = refp.vertices();
+    let mut tmp = Poly::new();
     for k in 0..lp.len() {
-        let a = refp.vertices[lp[k] as usize];
-        let b = refp.vertices[lp[(k + 1) % lp.len()] as usize];
+        let a = rv[lp[k] as usize];
+        let b = rv[lp[(k + 1) % lp.len()] as usize];
         let side = (b - a).cross(nr).normalize_or_zero();
         clip(&poly, side, side.dot(a), k as u32, &mut tmp);
         std::mem::swap(&mut poly, &mut tmp);
@@ -260,67 +356,97 @@ fn clip_faces(
     if poly.is_empty() {
         // Deep or lateral configurations where the incident face misses the reference
         // face's prism: fall back to the deepest vertex of the incident shape.
-        let k = (0..inc.vertices.len())
-            .min_by(|&i, &j| {
-                let (pi, pj) = (inc.vertices[i].dot(n_in_inc), inc.vertices[j].dot(n_in_inc));
-                pi.partial_cmp(&pj).unwrap_or(std::cmp::Ordering::Equal)
-            })
+        let k = (0..iv.len())
+            .min_by(|&i, &j| iv[i].dot(n_in_inc).total_cmp(&iv[j].dot(n_in_inc)))
             .unwrap_or(0);
-        if let Some(v) = inc.vertices.get(k) {
+        if let Some(v) = iv.get(k) {
             poly.push((pose_ri.transform_point(*v), id | 0xFEFF));
         }
     }
-    poly.into_iter()
-        .filter_map(|(p, fid)| {
-            let s = nr.dot(p) - off;
-            (s <= prediction).then(|| {
-                (
-                    Contact {
-                        distance: s,
-                        point_a: p - nr * s,
-                        point_b: p,
-                        normal: nr,
-                    },
-                    fid,
-                )
-            })
+    out.extend(poly.into_iter().filter_map(|(p, fid)| {
+        let s = nr.dot(p) - off;
+        (s <= prediction).then(|| {
+            (
+                Contact {
+                    distance: s,
+                    point_a: p - nr * s,
+                    point_b: p,
+                    normal: nr,
+                },
+                fid,
+            )
         })
-        .collect()
+    }));
 }
 
 /// The full contact manifold of two polyhedra (B at `pose_ab` in A's frame), in A's frame
 /// with the query convention (normal from A towards B), or empty when they are further
-/// apart than `prediction`.
+/// apart than `prediction`. Allocates only the returned vector (see
+/// [`polyhedron_manifold_into`]).
 pub fn polyhedron_manifold(
     a: &Polyhedron,
     b: &Polyhedron,
     pose_ab: &Isometry,
     prediction: Real,
 ) -> Vec<(Contact, FeatureId)> {
-    let (sa, fa) = face_query(a, b, pose_ab);
+    let mut out = Vec::new();
+    polyhedron_manifold_into(a, b, pose_ab, prediction, &mut out);
+    out
+}
+
+/// [`polyhedron_manifold`] appending to `out`: no heap allocation for shapes with at most
+/// 64 vertices and faces and faces of at most 16 corners (after clipping).
+pub fn polyhedron_manifold_into(
+    a: &Polyhedron,
+    b: &Polyhedron,
+    pose_ab: &Isometry,
+    prediction: Real,
+    out: &mut Vec<(Contact, FeatureId)>,
+) {
+    // B's vertices and face planes in A's frame, once.
+    let vb: Buf = b
+        .vertices()
+        .iter()
+        .map(|v| pose_ab.transform_point(*v))
+        .collect();
+    let (sa, fa) = {
+        let na: Buf = a.faces.iter().map(|f| f.normal).collect();
+        let oa: SmallVec<[Real; 64]> = a.faces.iter().map(|f| f.offset).collect();
+        face_query(&na, &oa, &vb)
+    };
     if sa > prediction {
-        return Vec::new();
+        return;
     }
-    let pose_ba = pose_ab.inverse();
-    let (sb, fb) = face_query(b, a, &pose_ba);
+    let nb: Buf = b
+        .faces
+        .iter()
+        .map(|f| pose_ab.transform_vector(f.normal))
+        .collect();
+    let ob: SmallVec<[Real; 64]> = b
+        .faces
+        .iter()
+        .zip(&nb)
+        .map(|(f, n)| f.offset + n.dot(pose_ab.translation))
+        .collect();
+    let (sb, fb) = face_query(&nb, &ob, a.vertices());
     if sb > prediction {
-        return Vec::new();
+        return;
     }
-    let (se, ia, ib, axis) = edge_query(a, b, pose_ab);
+    let (se, ia, ib, axis) = edge_query(a, b, &vb, &nb);
     if se > prediction {
-        return Vec::new();
+        return;
     }
     let face_sep = sa.max(sb);
     let tol = 1.0e-3;
     if se > face_sep + tol * (1.0 + face_sep.abs()) && se > Real::NEG_INFINITY {
         let ea = a.edges[ia];
         let eb = b.edges[ib];
-        let (pa, qa) = (a.vertices[ea[0] as usize], a.vertices[ea[1] as usize]);
-        let pb = pose_ab.transform_point(b.vertices[eb[0] as usize]);
-        let qb = pose_ab.transform_point(b.vertices[eb[1] as usize]);
+        let va = a.vertices();
+        let (pa, qa) = (va[ea[0] as usize], va[ea[1] as usize]);
+        let (pb, qb) = (vb[eb[0] as usize], vb[eb[1] as usize]);
         let (ca, _) = closest_points_segment_segment(pa, qa, pb, qb);
         let id = 0x8000_0000 | ((ia as u32 & 0x7FFF) << 15) | (ib as u32 & 0x7FFF);
-        return vec![(
+        out.push((
             Contact {
                 distance: se,
                 point_a: ca,
@@ -328,18 +454,84 @@ pub fn polyhedron_manifold(
                 normal: axis,
             },
             id,
-        )];
+        ));
+        return;
     }
     // Prefer A's face unless B's is clearly better (stable reference choice).
     if sb > sa + tol * (1.0 + sa.abs()) {
         let id_base = ((fb as u32 & 0x3F) | 0x40) << 24;
-        clip_faces(b, fb, a, &pose_ba, prediction, id_base)
-            .into_iter()
-            .map(|(c, id)| (c.swapped().transformed(pose_ab), id))
-            .collect()
+        let mut tmp: SmallVec<[(Contact, FeatureId); 16]> = SmallVec::new();
+        clip_faces(b, fb, a, &pose_ab.inverse(), prediction, id_base, &mut tmp);
+        out.extend(
+            tmp.into_iter()
+                .map(|(c, id)| (c.swapped().transformed(pose_ab), id)),
+        );
     } else {
         let id_base = (fa as u32 & 0x3F) << 24;
-        clip_faces(a, fa, b, pose_ab, prediction, id_base)
+        clip_faces(a, fa, b, pose_ab, prediction, id_base, out);
+    }
+}
+
+/// Up to this many edge pairs (and always with a triangle) the dispatcher runs the full
+/// separating-axis test, quadratic in the edge count; boxes and hulls go through
+/// [`polyhedron_manifold_guided`].
+pub const SAT_MAX_EDGE_PAIRS: usize = 16;
+
+/// Cosine under which a contact normal counts as a face normal in
+/// [`polyhedron_manifold_guided`] (about 2.6 degrees).
+const FACE_COS: Real = 0.999;
+
+/// The full manifold of two polyhedra guided by GJK/EPA instead of the full SAT (the approach
+/// of parry's `contact_manifolds_pfm_pfm` and Bullet's `btPolyhedralContactClipping` after
+/// a GJK normal): one penetration query gives the normal `n`; when `n` is within about 2.6°
+/// of a face normal of A (or of B), that face is the reference face and the other shape's
+/// most anti-parallel face is clipped against it as in [`polyhedron_manifold`]; otherwise
+/// (edge–edge, vertex contacts) the single GJK/EPA point is the manifold. Cost: one GJK/EPA
+/// plus a scan of the faces, linear in the size of the shapes. `ca`/`cb` are the shapes
+/// behind the views `a`/`b`.
+#[allow(clippy::too_many_arguments)]
+pub fn polyhedron_manifold_guided(
+    a: &Polyhedron,
+    b: &Polyhedron,
+    ca: ConvexRef<'_>,
+    cb: ConvexRef<'_>,
+    pose_ab: &Isometry,
+    prediction: Real,
+    out: &mut Vec<(Contact, FeatureId)>,
+) {
+    let Some(c) = contact_convex(ca, cb, pose_ab, prediction) else {
+        return;
+    };
+    let best_face = |p: &Polyhedron, n: Vec3| {
+        p.faces()
+            .iter()
+            .enumerate()
+            .fold((0, Real::NEG_INFINITY), |best, (i, f)| {
+                let d = f.normal.dot(n);
+                if d > best.1 {
+                    (i, d)
+                } else {
+                    best
+                }
+            })
+    };
+    let (fa, da) = best_face(a, c.normal);
+    let (fb, db) = best_face(b, pose_ab.inverse_transform_vector(-c.normal));
+    let start = out.len();
+    if da >= FACE_COS && da + 1.0e-4 >= db {
+        let id_base = (fa as u32 & 0x3F) << 24;
+        clip_faces(a, fa, b, pose_ab, prediction, id_base, out);
+    } else if db >= FACE_COS {
+        let id_base = ((fb as u32 & 0x3F) | 0x40) << 24;
+        let mut tmp: SmallVec<[(Contact, FeatureId); 16]> = SmallVec::new();
+        clip_faces(b, fb, a, &pose_ab.inverse(), prediction, id_base, &mut tmp);
+        out.extend(
+            tmp.into_iter()
+                .map(|(c, id)| (c.swapped().transformed(pose_ab), id)),
+        );
+    }
+    if out.len() == start {
+        out.push((c, 0x8000_0000 | 0x7FFF_FFFF));
     }
 }
 
@@ -352,7 +544,7 @@ pub fn plane_polyhedron_manifold(
     pose_ab: &Isometry,
     prediction: Real,
 ) -> Vec<(Contact, FeatureId)> {
-    b.vertices
+    b.vertices()
         .iter()
         .enumerate()
         .filter_map(|(i, v)| {

@@ -35,6 +35,8 @@ pub struct ConvexHull {
     faces: Vec<HullFace>,
     face_vertex_indices: Vec<u32>,
     edges: Vec<[u32; 2]>,
+    /// For edge `[a, b]`: the face running `a → b` and the face running `b → a`.
+    edge_faces: Vec<[u32; 2]>,
     /// Vertex `v`'s neighbours are `neighbors[neighbor_offsets[v]..neighbor_offsets[v + 1]]`.
     neighbor_offsets: Vec<u32>,
     neighbors: Vec<u32>,
@@ -68,7 +70,8 @@ impl ConvexHull {
         let mut face_vertex_indices = Vec::new();
         let mut triangles = Vec::new();
         let mut edges = Vec::new();
-        for poly in &faces {
+        let mut directed: Vec<([u32; 2], u32)> = Vec::new();
+        for (fi, poly) in faces.iter().enumerate() {
             // The normal: the corner cross products (v_k − v_{k−1}) × (v_{k+1} − v_k) all point
             // along it for a convex polygon. Built from edge vectors (differences of nearby
             // floats, exact) rather than positions as in Newell's method, and weighted by the
@@ -100,6 +103,7 @@ impl ConvexHull {
             }
             for k in 0..poly.len() {
                 let (a, b) = (poly[k], poly[(k + 1) % poly.len()]);
+                directed.push(([a, b], fi as u32));
                 if a < b {
                     edges.push([a, b]);
                 }
@@ -107,6 +111,7 @@ impl ConvexHull {
         }
         edges.sort_unstable();
         edges.dedup();
+        let edge_faces = edge_face_pairs(&edges, directed);
         let (neighbor_offsets, neighbors) = vertex_adjacency(vertices.len(), &edges);
         let local_aabb = Aabb::from_points(vertices.iter().copied());
         let (volume, unit_mass) = scaled_mass_properties(&vertices, &triangles, &local_aabb);
@@ -115,6 +120,7 @@ impl ConvexHull {
             faces: hull_faces,
             face_vertex_indices,
             edges,
+            edge_faces,
             neighbor_offsets,
             neighbors,
             triangles,
@@ -149,6 +155,13 @@ impl ConvexHull {
     /// Unique edges as vertex index pairs `(a, b)` with `a < b`.
     pub fn edges(&self) -> &[[u32; 2]] {
         &self.edges
+    }
+
+    /// The two faces adjacent to each edge of [`ConvexHull::edges`]: for edge `[a, b]`, the
+    /// face whose loop runs `a → b`, then the one running `b → a` (the edge's arc on the Gauss
+    /// map, for the separating-axis test of contact generation).
+    pub fn edge_faces(&self) -> &[[u32; 2]] {
+        &self.edge_faces
     }
 
     /// The vertices joined to vertex `v` by an edge, in increasing order.
@@ -238,6 +251,29 @@ impl SupportMap for ConvexHull {
     fn margin(&self) -> Real {
         0.0
     }
+}
+
+/// The faces on both sides of each edge (see [`ConvexHull::edge_faces`]); a missing twin
+/// (never for a closed hull) repeats the known face.
+pub(crate) fn edge_face_pairs(
+    edges: &[[u32; 2]],
+    mut directed: Vec<([u32; 2], u32)>,
+) -> Vec<[u32; 2]> {
+    directed.sort_unstable();
+    let face = |e: [u32; 2]| {
+        directed
+            .binary_search_by(|d| d.0.cmp(&e))
+            .ok()
+            .map(|i| directed[i].1)
+    };
+    edges
+        .iter()
+        .map(|&[a, b]| {
+            let (f, g) = (face([a, b]), face([b, a]));
+            let f = f.or(g).unwrap_or(0);
+            [f, g.unwrap_or(f)]
+        })
+        .collect()
 }
 
 /// Compressed vertex adjacency (offsets, neighbour lists sorted by index) from unique edges.

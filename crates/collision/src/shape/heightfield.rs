@@ -1,7 +1,7 @@
 //! Heightfield: a regular grid of heights, two triangles per cell, with no BVH (the grid is
 //! its own acceleration structure; queries live in `midphase::heightfield_query`).
 
-use super::MassProperties;
+use super::{classify_edge, MassProperties, MeshEdge, BOUNDARY_EDGE, DEFAULT_FLAT_ANGLE};
 use crate::error::{CaromError, Result};
 use crate::math::{check_finite, check_positive, Aabb, Real, Vec3};
 use serde::{Deserialize, Serialize};
@@ -118,6 +118,48 @@ impl HeightField {
                 self.point(r + 1, c + 1),
             ]
         }
+    }
+
+    /// The triangle across edge `k` (from corner `k` to `k + 1`) of triangle `t`, from the
+    /// grid topology, or `None` on the border.
+    pub fn triangle_neighbor(&self, t: usize, k: usize) -> Option<usize> {
+        let w = self.cols - 1;
+        let cell = t / 2;
+        let (r, c) = (cell / w, cell % w);
+        let even = t.is_multiple_of(2);
+        match (even, k) {
+            (true, 0) => (c > 0).then(|| 2 * (cell - 1) + 1),
+            (true, 1) => Some(t + 1),
+            (true, _) => (r > 0).then(|| 2 * (cell - w) + 1),
+            (false, 0) => Some(t - 1),
+            (false, 1) => (r + 2 < self.rows).then(|| 2 * (cell + w)),
+            (false, _) => (c + 1 < w).then(|| 2 * (cell + 1)),
+        }
+    }
+
+    /// Adjacency and convexity of the three edges of triangle `t` (as
+    /// [`crate::shape::TriMesh::edges`] gives them for meshes; flat below
+    /// [`DEFAULT_FLAT_ANGLE`]), computed from the grid on demand, for internal-edge correction.
+    pub fn triangle_edges(&self, t: usize) -> [MeshEdge; 3] {
+        let tri = self.triangle(t);
+        let normal = |v: &[Vec3; 3]| (v[1] - v[0]).cross(v[2] - v[0]).normalize_or_zero();
+        let n = normal(&tri);
+        std::array::from_fn(|k| {
+            let Some(o) = self.triangle_neighbor(t, k) else {
+                return BOUNDARY_EDGE;
+            };
+            let other = self.triangle(o);
+            let (p0, p1) = (tri[k], tri[(k + 1) % 3]);
+            let far = other
+                .into_iter()
+                .max_by(|a, b| {
+                    let da = (*a - p0).cross(p1 - p0).length_squared();
+                    let db = (*b - p0).cross(p1 - p0).length_squared();
+                    da.total_cmp(&db)
+                })
+                .unwrap_or(p0);
+            classify_edge(n, normal(&other), p0, far, o as u32, DEFAULT_FLAT_ANGLE)
+        })
     }
 
     /// Local bounding box.

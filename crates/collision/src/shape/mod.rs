@@ -8,7 +8,7 @@
 mod capsule;
 mod compound;
 mod cone;
-mod convex_hull;
+pub(crate) mod convex_hull;
 mod cuboid;
 mod cylinder;
 mod heightfield;
@@ -41,7 +41,8 @@ pub use support::SupportMap;
 pub use triangle::Triangle;
 pub use trimesh::{triangle_aabbs, TriMesh, TriMeshOptions};
 pub use trimesh_edges::{
-    compute_edges, weld_vertices, EdgeKind, MeshEdge, DEFAULT_FLAT_ANGLE, NO_NEIGHBOR,
+    classify_edge, compute_edges, weld_vertices, EdgeKind, MeshEdge, BOUNDARY_EDGE,
+    DEFAULT_FLAT_ANGLE, NO_NEIGHBOR,
 };
 
 use crate::error::{CaromError, Result};

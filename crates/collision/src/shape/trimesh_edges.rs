@@ -221,6 +221,20 @@ fn edge_info(
             da.total_cmp(&db)
         })
         .unwrap_or(p0);
+    classify_edge(n, m, p0, far, other, flat_angle)
+}
+
+/// The edge between a face of unit normal `n` and a neighbour `other` of unit normal `m`
+/// (consistently wound) whose corner off the shared edge is `far`; `p0` is on the edge.
+/// The sign of the dihedral angle says on which side of the face the neighbour bends.
+pub fn classify_edge(
+    n: Vec3,
+    m: Vec3,
+    p0: Vec3,
+    far: Vec3,
+    other: u32,
+    flat_angle: Real,
+) -> MeshEdge {
     let unsigned = n.cross(m).length().atan2(n.dot(m));
     let below = (far - p0).dot(n) <= 0.0;
     let angle = if below { unsigned } else { -unsigned };
@@ -237,6 +251,9 @@ fn edge_info(
         kind,
     }
 }
+
+/// A boundary edge (no neighbour).
+pub const BOUNDARY_EDGE: MeshEdge = BOUNDARY;
 
 #[cfg(test)]
 mod tests {
