@@ -13,7 +13,7 @@ use super::manifold::{ContactManifold, ManifoldConfig};
 use super::mesh::{mesh_convex_contacts, mix_feature};
 use super::polyhedron::{plane_polyhedron_manifold, polyhedron_manifold, Polyhedron};
 use crate::error::{CaromError, Result};
-use crate::math::Isometry;
+use crate::math::{Isometry, Real};
 use crate::query::contact::{contact_convex_plane, contact_plane_convex};
 use crate::query::{contact_convex, Contact};
 use crate::shape::{ConvexRef, Plane, Shape, ShapeKind};
@@ -318,15 +318,27 @@ impl Dispatcher {
         pose_ab: &Isometry,
         want_full: bool,
     ) -> Result<Generated> {
+        self.generate_with(a, b, pose_ab, &self.config, want_full)
+    }
+
+    /// [`Dispatcher::generate`] with another configuration (e.g. a per-pair prediction).
+    pub fn generate_with(
+        &self,
+        a: &Shape,
+        b: &Shape,
+        pose_ab: &Isometry,
+        cfg: &ManifoldConfig,
+        want_full: bool,
+    ) -> Result<Generated> {
         let (ka, kb) = (a.kind(), b.kind());
         if let Some(f) = self.user.get(&(ka, kb)) {
-            return Ok(f(a, b, pose_ab, &self.config, want_full));
+            return Ok(f(a, b, pose_ab, cfg, want_full));
         }
         if let Some(f) = self.user.get(&(kb, ka)) {
             let pose_ba = pose_ab.inverse();
-            return Ok(swap(f(b, a, &pose_ba, &self.config, want_full), pose_ab));
+            return Ok(swap(f(b, a, &pose_ba, cfg, want_full), pose_ab));
         }
-        generate(a, b, pose_ab, &self.config, want_full)
+        generate(a, b, pose_ab, cfg, want_full)
     }
 
     /// One step of the persistent manifold: refresh from the poses, generate, then replace
@@ -339,10 +351,36 @@ impl Dispatcher {
         pose_b: &Isometry,
         manifold: &mut ContactManifold,
     ) -> Result<()> {
-        let cfg = &self.config;
+        let p = self.config.prediction;
+        self.update_manifold_with_prediction(a, pose_a, b, pose_b, manifold, p)
+    }
+
+    /// [`Dispatcher::update_manifold`] with a per-pair speculative margin: points are
+    /// generated while the shapes are at most `prediction` apart (never less than the
+    /// configured prediction), and cached points survive up to that distance. A dynamics
+    /// pipeline passes the relative motion of the pair over the step, so that the solver sees
+    /// speculative contacts before fast bodies meet (Catto, "Continuous Collision", GDC 2013;
+    /// Rapier's soft CCD prediction distance).
+    pub fn update_manifold_with_prediction(
+        &self,
+        a: &Shape,
+        pose_a: &Isometry,
+        b: &Shape,
+        pose_b: &Isometry,
+        manifold: &mut ContactManifold,
+        prediction: Real,
+    ) -> Result<()> {
+        let base = &self.config;
+        let prediction = prediction.max(base.prediction);
+        let local = ManifoldConfig {
+            prediction,
+            breaking_threshold: base.breaking_threshold.max(prediction),
+            ..*base
+        };
+        let cfg = &local;
         manifold.refresh(pose_a, pose_b, cfg.breaking_threshold);
         let pose_ab = pose_a.inv_mul(pose_b);
-        let g = self.generate(a, b, &pose_ab, manifold.is_empty())?;
+        let g = self.generate_with(a, b, &pose_ab, cfg, manifold.is_empty())?;
         let pts: Vec<ContactPoint> = g
             .contacts
             .iter()

@@ -20,4 +20,4 @@ pub mod polyhedron;
 
 pub use dispatcher::{Dispatcher, Generated, UserAlgorithm};
 pub mod pipeline;
-pub use pipeline::{ContactEvent, ContactEventKind, NarrowPhase, PairContact};
+pub use pipeline::{ContactEvent, ContactEventKind, NarrowObject, NarrowPhase, PairContact};

@@ -10,6 +10,8 @@ use crate::math::{Isometry, Real, Vec3};
 use crate::query::closest_points::closest_points_segment_segment;
 use crate::query::Contact;
 use crate::shape::{ConvexHull, Cuboid, Triangle};
+use std::borrow::Cow;
+use std::sync::OnceLock;
 
 /// A convex polyhedron view: vertices, faces (plane + counter-clockwise vertex loop) and
 /// edges with their two adjacent faces (for the Gauss map).
@@ -19,10 +21,10 @@ pub struct Polyhedron {
     pub vertices: Vec<Vec3>,
     /// Faces: unit outward normal, plane offset, range in `loops`.
     pub faces: Vec<(Vec3, Real, u32, u32)>,
-    /// Concatenated counter-clockwise vertex loops of the faces.
-    pub loops: Vec<u32>,
-    /// Edges: two vertex indices and the two adjacent faces.
-    pub edges: Vec<[u32; 4]>,
+    /// Concatenated counter-clockwise vertex loops of the faces (shared by every box).
+    pub loops: Cow<'static, [u32]>,
+    /// Edges: two vertex indices and the two adjacent faces (shared by every box).
+    pub edges: Cow<'static, [[u32; 4]]>,
     /// True for a flat polygon (a triangle): its edges' Gauss arcs are half circles and
     /// are never pruned.
     pub flat: bool,
@@ -41,6 +43,7 @@ impl Polyhedron {
             flat,
             ..Default::default()
         };
+        let (mut loops_out, mut edges_out) = (Vec::new(), Vec::new());
         let mut directed: Vec<(u32, u32, u32)> = Vec::new();
         for (fi, lp) in loops.iter().enumerate() {
             let v = &p.vertices;
@@ -53,8 +56,8 @@ impl Polyhedron {
             let n = n.normalize_or_zero();
             let off = n.dot(v[lp[0] as usize]);
             p.faces
-                .push((n, off, p.loops.len() as u32, lp.len() as u32));
-            p.loops.extend_from_slice(lp);
+                .push((n, off, loops_out.len() as u32, lp.len() as u32));
+            loops_out.extend_from_slice(lp);
             for k in 0..lp.len() {
                 directed.push((lp[k], lp[(k + 1) % lp.len()], fi as u32));
             }
@@ -64,16 +67,40 @@ impl Polyhedron {
         for &(i, j, f) in &directed {
             if i < j {
                 if let Ok(t) = directed.binary_search_by(|e| (e.0, e.1).cmp(&(j, i))) {
-                    p.edges.push([i, j, f, directed[t].2]);
+                    edges_out.push([i, j, f, directed[t].2]);
                 }
             }
         }
+        p.loops = Cow::Owned(loops_out);
+        p.edges = Cow::Owned(edges_out);
         p
     }
 
     /// The box as a polyhedron (its exact half extents, margin ignored).
+    ///
+    /// The topology (loops, edges, face normals) is that of the unit box, built once and
+    /// shared; only the vertices and face offsets are computed per call (this runs for every
+    /// box pair at every step).
     pub fn from_cuboid(b: &Cuboid) -> Polyhedron {
+        static UNIT: OnceLock<Polyhedron> = OnceLock::new();
+        let unit = UNIT.get_or_init(|| Self::cuboid_with(Vec3::ONE));
         let h = b.half_extents();
+        let vertices: Vec<Vec3> = unit.vertices.iter().map(|v| *v * h).collect();
+        let faces = unit
+            .faces
+            .iter()
+            .map(|&(n, _, s, c)| (n, n.dot(vertices[unit.loops[s as usize] as usize]), s, c))
+            .collect();
+        Polyhedron {
+            vertices,
+            faces,
+            loops: Cow::Borrowed(&unit.loops[..]),
+            edges: Cow::Borrowed(&unit.edges[..]),
+            flat: false,
+        }
+    }
+
+    fn cuboid_with(h: Vec3) -> Polyhedron {
         let vertices: Vec<Vec3> = (0..8)
             .map(|i| {
                 Vec3::new(
