@@ -270,7 +270,7 @@ impl CollisionWorld {
         self.narrowphase.step(added, removed, |h: ObjectHandle| {
             let o = objects.get(h.index as usize)?.as_ref()?;
             (o.handle == h).then_some(NarrowObject {
-                shape: &*o.shape,
+                shape: &o.shape,
                 pose: o.pose,
                 margin: o.margin,
                 active: !o.resting,

@@ -161,6 +161,13 @@ fn falling_boxes_demo() -> Result<(), Box<dyn std::error::Error>> {
         "last step: {} pairs, {} manifolds, {} contact points",
         r.pairs, r.manifolds, r.contact_points
     );
+    let deepest = world
+        .collision()
+        .narrowphase()
+        .manifolds()
+        .filter_map(|pc| pc.manifold.min_distance())
+        .fold(0.0 as Real, Real::min);
+    println!("deepest penetration among contacts: {:.4} m", -deepest);
     let bodies = world.bodies();
     let heights: Vec<Real> = bodies
         .handles()

@@ -176,14 +176,23 @@ fn edge_query(a: &Polyhedron, b: &Polyhedron, pose_ab: &Isometry) -> (Real, usiz
     let ident = Isometry::IDENTITY;
     let a_centre =
         a.vertices.iter().fold(Vec3::ZERO, |s, v| s + *v) / a.vertices.len().max(1) as Real;
+    // B's vertices and face normals in A's frame, once (not once per edge pair).
+    let b_vertices: Vec<Vec3> = b
+        .vertices
+        .iter()
+        .map(|v| pose_ab.transform_point(*v))
+        .collect();
+    let b_normals: Vec<Vec3> = b
+        .faces
+        .iter()
+        .map(|f| pose_ab.transform_vector(f.0))
+        .collect();
     for (i, ea) in a.edges.iter().enumerate() {
         let (pa, qa) = (a.vertices[ea[0] as usize], a.vertices[ea[1] as usize]);
         let (na0, na1) = (a.faces[ea[2] as usize].0, a.faces[ea[3] as usize].0);
         for (j, eb) in b.edges.iter().enumerate() {
-            let pb = pose_ab.transform_point(b.vertices[eb[0] as usize]);
-            let qb = pose_ab.transform_point(b.vertices[eb[1] as usize]);
-            let nb0 = pose_ab.transform_vector(b.faces[eb[2] as usize].0);
-            let nb1 = pose_ab.transform_vector(b.faces[eb[3] as usize].0);
+            let (pb, qb) = (b_vertices[eb[0] as usize], b_vertices[eb[1] as usize]);
+            let (nb0, nb1) = (b_normals[eb[2] as usize], b_normals[eb[3] as usize]);
             if !a.flat && !b.flat && !is_minkowski_face(na0, na1, -nb0, -nb1) {
                 continue;
             }
