@@ -120,7 +120,14 @@ fn falling_boxes_demo() -> Result<(), Box<dyn std::error::Error>> {
         rayon::current_num_threads()
     );
     let t0 = Instant::now();
-    let mut world = World::from_scene(&scene)?;
+    let mut params = carom_dynamics::PipelineParams::default();
+    if let Some(n) = std::env::var("CAROM_SUBSTEPS")
+        .ok()
+        .and_then(|s| s.parse().ok())
+    {
+        params.dynamics.solver.substeps = n;
+    }
+    let mut world = World::from_scene_with(&scene, params)?;
     println!("world built in {:.1} ms", t0.elapsed().as_secs_f64() * 1e3);
     let mut per_step = Vec::with_capacity(steps);
     let mut stages = PipelineTimings::default();
