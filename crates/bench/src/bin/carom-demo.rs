@@ -105,7 +105,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
 }
 
 /// Simulates Bullet's "3000 fall" scene through the whole pipeline (`carom_dynamics::World`)
-/// and prints steps, ms/step, stage times, resting bodies and final heights.
+/// and prints steps, ms/step, stage times, resting bodies and final heights
+/// (`CAROM_DEMO_STEPS` and `CAROM_SUBSTEPS` override the step and substep counts).
 fn falling_boxes_demo() -> Result<(), Box<dyn std::error::Error>> {
     let steps: usize = std::env::var("CAROM_DEMO_STEPS")
         .ok()
