@@ -8,10 +8,11 @@
 
 use crate::broadphase::{AnyBroadPhase, BroadPhase, Filter, Method, ProxyHandle, UserFilter};
 use crate::error::{CaromError, Result};
-use crate::math::{check_isometry, Aabb, Isometry, Vec3};
-use crate::narrowphase::NarrowPhase;
+use crate::math::{check_isometry, Aabb, Isometry, Real, Vec3};
+use crate::narrowphase::{NarrowObject, NarrowPhase};
 use crate::shape::Shape;
 use std::sync::Arc;
+use std::time::{Duration, Instant};
 
 /// A handle to an object of a [`CollisionWorld`]: its slot and the slot's generation
 /// (the broadphase proxy handle of the object).
@@ -50,8 +51,15 @@ pub struct CollisionObject {
     pub pose: Isometry,
     /// Collision filter.
     pub filter: Filter,
-    /// World box at the last update.
+    /// World box at the last update (the shape's box expanded by `margin`).
     pub aabb: Aabb,
+    /// Speculative margin (length): the box is expanded by it and a pair generates contact
+    /// points up to `max(prediction, margin_a + margin_b)` apart. A dynamics pipeline sets
+    /// it from the object's motion over the coming step. 0 by default.
+    pub margin: Real,
+    /// True when hinted resting ([`CollisionWorld::set_resting`]) or static: pairs of two
+    /// such objects are not updated by the narrowphase.
+    pub resting: bool,
     handle: ObjectHandle,
     dirty: bool,
     displacement: Vec3,
@@ -66,6 +74,15 @@ pub struct WorldPairChanges {
     pub removed: Vec<(ObjectHandle, ObjectHandle)>,
 }
 
+/// Wall-clock time of the stages of the last [`CollisionWorld::update`].
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct UpdateTimings {
+    /// Box updates and broadphase pair update.
+    pub broadphase: Duration,
+    /// Narrowphase (manifold updates of every pair).
+    pub narrowphase: Duration,
+}
+
 /// Objects plus a broadphase (see the module docs).
 #[derive(Debug, Clone, Default)]
 pub struct CollisionWorld {
@@ -74,6 +91,7 @@ pub struct CollisionWorld {
     dirty: Vec<u32>,
     changes: WorldPairChanges,
     narrowphase: NarrowPhase<ObjectHandle>,
+    timings: UpdateTimings,
 }
 
 impl CollisionWorld {
@@ -126,6 +144,8 @@ impl CollisionWorld {
             pose,
             filter,
             aabb,
+            margin: 0.0,
+            resting: filter.is_static,
             handle,
             dirty: false,
             displacement: Vec3::ZERO,
@@ -160,18 +180,41 @@ impl CollisionWorld {
         Ok(())
     }
 
+    /// Moves an object and sets its speculative margin (see [`CollisionObject::margin`]); a
+    /// negative or non-finite margin is an error.
+    pub fn set_pose_with_margin(
+        &mut self,
+        h: ObjectHandle,
+        pose: Isometry,
+        margin: Real,
+    ) -> Result<()> {
+        let margin = crate::math::check_non_negative("margin", margin)?;
+        self.set_pose(h, pose)?;
+        self.objects[h.index as usize]
+            .as_mut()
+            .expect("slot checked")
+            .margin = margin;
+        Ok(())
+    }
+
     /// Changes an object's filter.
     pub fn set_filter(&mut self, h: ObjectHandle, filter: Filter) -> Result<()> {
         let i = self.slot(h)?;
         self.broadphase.set_filter(h.proxy(), filter)?;
-        self.objects[i].as_mut().expect("slot checked").filter = filter;
+        let o = self.objects[i].as_mut().expect("slot checked");
+        o.filter = filter;
+        o.resting |= filter.is_static;
         Ok(())
     }
 
-    /// Hints that an object is resting (sleeping) or moving again.
+    /// Hints that an object is resting (sleeping) or moving again. Pairs of two resting (or
+    /// static) objects keep their manifolds unchanged until one of them moves again.
     pub fn set_resting(&mut self, h: ObjectHandle, resting: bool) -> Result<()> {
-        self.slot(h)?;
-        self.broadphase.set_resting(h.proxy(), resting)
+        let i = self.slot(h)?;
+        self.broadphase.set_resting(h.proxy(), resting)?;
+        let o = self.objects[i].as_mut().expect("slot checked");
+        o.resting = resting || o.filter.is_static;
+        Ok(())
     }
 
     /// Removes an object; its pairs are reported as removed by the next update.
@@ -193,6 +236,7 @@ impl CollisionWorld {
 
     /// Recomputes the boxes of moved objects and updates the broadphase pairs.
     pub fn update(&mut self) -> Result<&WorldPairChanges> {
+        let start = Instant::now();
         let mut dirty = std::mem::take(&mut self.dirty);
         dirty.sort_unstable();
         for &i in &dirty {
@@ -204,6 +248,9 @@ impl CollisionWorld {
             }
             o.dirty = false;
             o.aabb = o.shape.aabb(&o.pose);
+            if o.margin > 0.0 {
+                o.aabb = o.aabb.expanded(o.margin);
+            }
             self.broadphase
                 .update_proxy(o.handle.proxy(), o.aabb, o.displacement)?;
         }
@@ -217,13 +264,28 @@ impl CollisionWorld {
             added: conv(&ch.added),
             removed: conv(&ch.removed),
         };
+        let mid = Instant::now();
         let objects = &self.objects;
         let (added, removed) = (&self.changes.added, &self.changes.removed);
         self.narrowphase.step(added, removed, |h: ObjectHandle| {
             let o = objects.get(h.index as usize)?.as_ref()?;
-            (o.handle == h).then_some((&*o.shape, o.pose))
+            (o.handle == h).then_some(NarrowObject {
+                shape: &o.shape,
+                pose: o.pose,
+                margin: o.margin,
+                active: !o.resting,
+            })
         })?;
+        self.timings = UpdateTimings {
+            broadphase: mid - start,
+            narrowphase: mid.elapsed(),
+        };
         Ok(&self.changes)
+    }
+
+    /// Stage timings of the last [`CollisionWorld::update`].
+    pub fn timings(&self) -> UpdateTimings {
+        self.timings
     }
 
     /// The narrowphase: manifolds and contact events of the last update.

@@ -4,6 +4,7 @@
 //! Jolt (`BodyCreationSettings`): a [`BodyDesc`] with [`Default`], turned into live hot data by
 //! [`crate::BodySet::insert`].
 
+use carom_collision::broadphase::Filter;
 use carom_collision::math::{
     check_finite, check_finite_vec, check_isometry, check_non_negative, check_positive, Isometry,
     Mat3, Real, Vec3,
@@ -69,6 +70,9 @@ pub struct BodyDesc {
     pub max_angular_speed: Real,
     /// Arbitrary user value.
     pub user_data: u64,
+    /// Collision filter of the body's collision object in a [`crate::World`] (groups and
+    /// masks; `is_static` is set from `body_type`).
+    pub filter: Filter,
 }
 
 impl Default for BodyDesc {
@@ -89,6 +93,7 @@ impl Default for BodyDesc {
             max_linear_speed: 400.0,
             max_angular_speed: 100.0,
             user_data: 0,
+            filter: Filter::default(),
         }
     }
 }

@@ -10,16 +10,10 @@
 //! [`DynamicsWorld::step`] takes this step's contacts as `&mut [ContactManifold]`: one
 //! manifold per touching pair, with body-local witness points, the refreshed separation and
 //! the accumulated impulses of the previous step. It writes the new impulses (and the
-//! friction direction) back into the same manifolds. The full `World::step` on top of
-//! `CollisionWorld` (issue 6) will:
-//! 1. copy body poses ([`BodySet::pose`]) into the collision objects;
-//! 2. run broadphase → midphase → narrowphase, skipping pairs for which
-//!    [`DynamicsWorld::should_collide`] is false (joints with `disable_collisions`, two
-//!    non-dynamic bodies);
-//! 3. fill a [`ContactManifold`] per persistent manifold (its points keep their impulses by
-//!    feature id), call `step`, and copy the impulses back into the persistent manifolds;
-//! 4. move the bodies of [`StepReport::slept`] / [`StepReport::woken`] between the
-//!    broadphase's resting and active trees.
+//! friction direction) back into the same manifolds. [`World`] (module [`pipeline`]) bundles
+//! it with a `CollisionWorld`: its `step(dt)` syncs poses with speculative margins, runs the
+//! broadphase and narrowphase, turns the persistent manifolds into solver contacts (normal
+//! from A to B), solves, and writes the impulses back for the next step's warm start.
 //!
 //! ## Solver choice
 //!
@@ -51,6 +45,7 @@ mod contact;
 mod integrate;
 mod island;
 pub mod joint;
+pub mod pipeline;
 pub mod solver;
 mod world;
 
@@ -61,5 +56,6 @@ pub use island::SleepParams;
 pub use joint::{
     Axis, AxisMode, Joint, JointDesc, JointHandle, JointKind, JointSet, Motor, Spring,
 };
+pub use pipeline::{PipelineParams, PipelineReport, PipelineTimings, World};
 pub use solver::{SolverKind, SolverParams, StepTimings};
 pub use world::{DynamicsWorld, StepReport, WorldParams};

@@ -3,6 +3,7 @@
 
 use carom_collision::math::{Isometry, Quat, Real, Vec3};
 use carom_collision::shape::*;
+use carom_dynamics::{PipelineTimings, World};
 use carom_scenes::bullet;
 use std::sync::Arc;
 use std::time::Instant;
@@ -97,5 +98,100 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             ms
         );
     }
+
+    println!();
+    falling_boxes_demo()?;
+    Ok(())
+}
+
+/// Simulates Bullet's "3000 fall" scene through the whole pipeline (`carom_dynamics::World`)
+/// and prints steps, ms/step, stage times, resting bodies and final heights
+/// (`CAROM_DEMO_STEPS` and `CAROM_SUBSTEPS` override the step and substep counts).
+fn falling_boxes_demo() -> Result<(), Box<dyn std::error::Error>> {
+    let steps: usize = std::env::var("CAROM_DEMO_STEPS")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(300);
+    let scene = bullet::falling_boxes();
+    println!(
+        "== Simulation: \"{}\" ({} dynamic boxes, dt = 1/{:.0} s, {} threads) ==",
+        scene.name,
+        scene.dynamic_count(),
+        1.0 / scene.dt,
+        rayon::current_num_threads()
+    );
+    let t0 = Instant::now();
+    let mut params = carom_dynamics::PipelineParams::default();
+    if let Some(n) = std::env::var("CAROM_SUBSTEPS")
+        .ok()
+        .and_then(|s| s.parse().ok())
+    {
+        params.dynamics.solver.substeps = n;
+    }
+    let mut world = World::from_scene_with(&scene, params)?;
+    println!("world built in {:.1} ms", t0.elapsed().as_secs_f64() * 1e3);
+    let mut per_step = Vec::with_capacity(steps);
+    let mut stages = PipelineTimings::default();
+    for _ in 0..steps {
+        let r = world.step(scene.dt)?;
+        per_step.push(r.timings.total.as_secs_f64() * 1e3);
+        let t = &r.timings;
+        stages.sync += t.sync;
+        stages.broadphase += t.broadphase;
+        stages.narrowphase += t.narrowphase;
+        stages.contacts += t.contacts;
+        stages.solver += t.solver;
+        stages.integrate += t.integrate;
+        stages.islands += t.islands;
+        stages.total += t.total;
+    }
+    let mean = per_step.iter().sum::<f64>() / steps.max(1) as f64;
+    let mut sorted = per_step.clone();
+    sorted.sort_by(f64::total_cmp);
+    let median = sorted.get(sorted.len() / 2).copied().unwrap_or(0.0);
+    let ms = |d: std::time::Duration| d.as_secs_f64() * 1e3 / steps.max(1) as f64;
+    println!(
+        "steps: {steps}; ms/step: mean {mean:.2}, median {median:.2}, max {:.2}",
+        sorted.last().copied().unwrap_or(0.0)
+    );
+    println!(
+        "per stage (ms/step): sync {:.2}, broadphase {:.2}, narrowphase {:.2}, contacts {:.2}, solver {:.2}, integrate {:.2}, islands {:.2}",
+        ms(stages.sync),
+        ms(stages.broadphase),
+        ms(stages.narrowphase),
+        ms(stages.contacts),
+        ms(stages.solver),
+        ms(stages.integrate),
+        ms(stages.islands)
+    );
+    let r = world.last_report();
+    println!(
+        "last step: {} pairs, {} manifolds, {} contact points",
+        r.pairs, r.manifolds, r.contact_points
+    );
+    let deepest = world
+        .collision()
+        .narrowphase()
+        .manifolds()
+        .filter_map(|pc| pc.manifold.min_distance())
+        .fold(0.0 as Real, Real::min);
+    println!("deepest penetration among contacts: {:.4} m", -deepest);
+    let bodies = world.bodies();
+    let heights: Vec<Real> = bodies
+        .handles()
+        .filter(|&h| bodies.inv_mass(h).is_ok_and(|m| m > 0.0))
+        .map(|h| bodies.center_of_mass(h).map(|p| p.y))
+        .collect::<Result<_, _>>()?;
+    let min = heights.iter().copied().fold(Real::INFINITY, Real::min);
+    let mean_h = heights.iter().sum::<Real>() / heights.len().max(1) as Real;
+    let below = heights.iter().filter(|&&y| y < 0.0).count();
+    println!(
+        "resting (asleep): {} of {}; centre heights: min {:.3} m, mean {:.3} m (box half height 1 m); below ground: {}",
+        world.sleeping_count(),
+        heights.len(),
+        min,
+        mean_h,
+        below
+    );
     Ok(())
 }

@@ -16,7 +16,7 @@ use super::polyhedron::{
     SAT_MAX_EDGE_PAIRS,
 };
 use crate::error::{CaromError, Result};
-use crate::math::Isometry;
+use crate::math::{Isometry, Real};
 use crate::query::contact::{contact_convex_plane, contact_plane_convex};
 use crate::query::{contact_convex, Contact};
 use crate::shape::{ConvexRef, Plane, Shape, ShapeKind, Triangle};
@@ -380,8 +380,20 @@ impl Dispatcher {
         pose_ab: &Isometry,
         want_full: bool,
     ) -> Result<Generated> {
+        self.generate_with(a, b, pose_ab, &self.config, want_full)
+    }
+
+    /// [`Dispatcher::generate`] with another configuration (e.g. a per-pair prediction).
+    pub fn generate_with(
+        &self,
+        a: &Shape,
+        b: &Shape,
+        pose_ab: &Isometry,
+        cfg: &ManifoldConfig,
+        want_full: bool,
+    ) -> Result<Generated> {
         let mut contacts = Vec::new();
-        let full = self.generate_into(a, b, pose_ab, want_full, &mut contacts)?;
+        let full = self.generate_into_with(a, b, pose_ab, cfg, want_full, &mut contacts)?;
         Ok(Generated { contacts, full })
     }
 
@@ -395,21 +407,31 @@ impl Dispatcher {
         want_full: bool,
         out: &mut ContactList,
     ) -> Result<bool> {
+        self.generate_into_with(a, b, pose_ab, &self.config, want_full, out)
+    }
+
+    /// [`Dispatcher::generate_into`] with another configuration.
+    pub fn generate_into_with(
+        &self,
+        a: &Shape,
+        b: &Shape,
+        pose_ab: &Isometry,
+        cfg: &ManifoldConfig,
+        want_full: bool,
+        out: &mut ContactList,
+    ) -> Result<bool> {
         let (ka, kb) = (a.kind(), b.kind());
         if let Some(f) = self.user.get(&(ka, kb)) {
-            let g = f(a, b, pose_ab, &self.config, want_full);
+            let g = f(a, b, pose_ab, cfg, want_full);
             out.extend(g.contacts);
             return Ok(g.full);
         }
         if let Some(f) = self.user.get(&(kb, ka)) {
-            let g = swap(
-                f(b, a, &pose_ab.inverse(), &self.config, want_full),
-                pose_ab,
-            );
+            let g = swap(f(b, a, &pose_ab.inverse(), cfg, want_full), pose_ab);
             out.extend(g.contacts);
             return Ok(g.full);
         }
-        generate_into(a, b, pose_ab, &self.config, want_full, out)
+        generate_into(a, b, pose_ab, cfg, want_full, out)
     }
 
     /// One step of the persistent manifold: refresh from the poses, generate, then replace
@@ -425,11 +447,37 @@ impl Dispatcher {
         pose_b: &Isometry,
         manifold: &mut ContactManifold,
     ) -> Result<()> {
+        let p = self.config.prediction;
+        self.update_manifold_with_prediction(a, pose_a, b, pose_b, manifold, p)
+    }
+
+    /// [`Dispatcher::update_manifold`] with a per-pair speculative margin: points are
+    /// generated while the shapes are at most `prediction` apart (never less than the
+    /// configured prediction), and cached points survive up to that distance. A dynamics
+    /// pipeline passes the relative motion of the pair over the step, so that the solver sees
+    /// speculative contacts before fast bodies meet (Catto, "Continuous Collision", GDC 2013;
+    /// Rapier's soft CCD prediction distance).
+    pub fn update_manifold_with_prediction(
+        &self,
+        a: &Shape,
+        pose_a: &Isometry,
+        b: &Shape,
+        pose_b: &Isometry,
+        manifold: &mut ContactManifold,
+        prediction: Real,
+    ) -> Result<()> {
         thread_local! {
             static SCRATCH: RefCell<(ContactList, Vec<ContactPoint>)> =
                 const { RefCell::new((Vec::new(), Vec::new())) };
         }
-        let cfg = &self.config;
+        let base = &self.config;
+        let prediction = prediction.max(base.prediction);
+        let local = ManifoldConfig {
+            prediction,
+            breaking_threshold: base.breaking_threshold.max(prediction),
+            ..*base
+        };
+        let cfg = &local;
         let before = manifold.len();
         manifold.refresh(pose_a, pose_b, cfg.breaking_threshold);
         let pose_ab = pose_a.inv_mul(pose_b);
@@ -446,7 +494,8 @@ impl Dispatcher {
             };
             contacts.clear();
             pts.clear();
-            let full = self.generate_into(a, b, &pose_ab, manifold.is_empty(), contacts)?;
+            let full =
+                self.generate_into_with(a, b, &pose_ab, cfg, manifold.is_empty(), contacts)?;
             pts.extend(
                 contacts
                     .iter()

@@ -22,4 +22,4 @@ pub mod polyhedron;
 
 pub use dispatcher::{Dispatcher, Generated, UserAlgorithm};
 pub mod pipeline;
-pub use pipeline::{ContactEvent, ContactEventKind, NarrowPhase, PairContact};
+pub use pipeline::{ContactEvent, ContactEventKind, NarrowObject, NarrowPhase, PairContact};

@@ -7,7 +7,7 @@
 use super::dispatcher::Dispatcher;
 use super::manifold::ContactManifold;
 use crate::error::Result;
-use crate::math::Isometry;
+use crate::math::{Isometry, Real};
 use crate::shape::Shape;
 use std::collections::{BTreeMap, BTreeSet};
 
@@ -24,6 +24,35 @@ pub struct PairContact<H> {
     pub touching: bool,
     /// True when one of the objects is a sensor.
     pub sensor: bool,
+}
+
+/// What the narrowphase needs to know about one object at a step.
+#[derive(Debug, Clone, Copy)]
+pub struct NarrowObject<'s> {
+    /// The shape.
+    pub shape: &'s Shape,
+    /// Its world pose.
+    pub pose: Isometry,
+    /// Speculative margin of the object: a pair generates points up to
+    /// `max(config.prediction, margin_a + margin_b)` apart (see
+    /// [`super::Dispatcher::update_manifold_with_prediction`]).
+    pub margin: Real,
+    /// False for objects that do not move (resting or static): a pair of two inactive
+    /// objects keeps its manifold (and impulses) unchanged, as sleeping pairs in Box2D and
+    /// Bullet are not updated.
+    pub active: bool,
+}
+
+impl<'s> NarrowObject<'s> {
+    /// An active object without speculative margin.
+    pub fn new(shape: &'s Shape, pose: Isometry) -> Self {
+        NarrowObject {
+            shape,
+            pose,
+            margin: 0.0,
+            active: true,
+        }
+    }
 }
 
 /// What happened to a pair's contact at a step.
@@ -118,8 +147,9 @@ impl<H: Copy + Ord + Send + Sync> NarrowPhase<H> {
     }
 
     /// One step: pairs `removed` are dropped and `added` created, then every manifold is
-    /// updated from the shapes and poses given by `lookup` (pairs whose objects are unknown
-    /// are skipped). Returns the events of this step, in pair order (removals first).
+    /// updated from the shapes and poses given by `lookup` (pairs whose objects are unknown,
+    /// or both inactive, are skipped and keep their state). Returns the events of this step,
+    /// in pair order (removals first).
     pub fn step<'s, F>(
         &mut self,
         added: &[(H, H)],
@@ -127,7 +157,7 @@ impl<H: Copy + Ord + Send + Sync> NarrowPhase<H> {
         lookup: F,
     ) -> Result<&[ContactEvent<H>]>
     where
-        F: Fn(H) -> Option<(&'s Shape, Isometry)> + Sync,
+        F: Fn(H) -> Option<NarrowObject<'s>> + Sync,
     {
         self.events.clear();
         for &(a, b) in removed {
@@ -140,16 +170,28 @@ impl<H: Copy + Ord + Send + Sync> NarrowPhase<H> {
         let sensors = &self.sensors;
         let update = |p: &mut PairContact<H>| -> Result<(bool, bool)> {
             let was = p.touching;
-            let (Some((sa, pa)), Some((sb, pb))) = (lookup(p.a), lookup(p.b)) else {
+            let (Some(oa), Some(ob)) = (lookup(p.a), lookup(p.b)) else {
                 return Ok((was, was));
             };
+            if !(oa.active || ob.active) {
+                return Ok((was, was));
+            }
+            let (sa, pa, sb, pb) = (oa.shape, oa.pose, ob.shape, ob.pose);
             p.sensor = sensors.contains(&p.a) || sensors.contains(&p.b);
             if p.sensor {
                 p.manifold.clear();
                 let g = dispatcher.generate(sa, sb, &pa.inv_mul(&pb), true)?;
                 p.touching = g.contacts.iter().any(|(c, _)| c.distance <= 0.0);
             } else {
-                dispatcher.update_manifold(sa, &pa, sb, &pb, &mut p.manifold)?;
+                let prediction = oa.margin + ob.margin;
+                dispatcher.update_manifold_with_prediction(
+                    sa,
+                    &pa,
+                    sb,
+                    &pb,
+                    &mut p.manifold,
+                    prediction,
+                )?;
                 p.touching = p.manifold.min_distance().is_some_and(|d| d <= 0.0);
             }
             Ok((was, p.touching))

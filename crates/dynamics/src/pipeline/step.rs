@@ -1,0 +1,167 @@
+//! [`World::step`] (one pipeline step) and [`World::step_simulation`] (fixed steps from a
+//! variable frame time), with per-stage timings.
+
+use super::World;
+use crate::body::BodyType;
+use crate::world::StepReport;
+use carom_collision::math::Real;
+use carom_collision::{CaromError, Result};
+use std::time::{Duration, Instant};
+
+/// Wall-clock time of each stage of the last [`World::step`] (like Bullet's
+/// `CProfileManager` sections or Box2D's `b2Profile`).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct PipelineTimings {
+    /// Body poses and speculative margins to the collision objects, sleep hints.
+    pub sync: Duration,
+    /// Box updates and broadphase pairs.
+    pub broadphase: Duration,
+    /// Contact generation (persistent manifolds, parallel over pairs).
+    pub narrowphase: Duration,
+    /// Manifolds to solver contacts and impulses back (the adapter).
+    pub contacts: Duration,
+    /// Gravity and forces, constraint preparation, warm start, velocity iterations, relax
+    /// and restitution.
+    pub solver: Duration,
+    /// Position integration.
+    pub integrate: Duration,
+    /// Islands, waking, sleeping, storing velocities, joint breaking.
+    pub islands: Duration,
+    /// The whole step.
+    pub total: Duration,
+}
+
+/// What happened during the last [`World::step`].
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct PipelineReport {
+    /// Stage timings.
+    pub timings: PipelineTimings,
+    /// Broadphase pairs (manifolds kept by the narrowphase).
+    pub pairs: usize,
+    /// Manifolds handed to the solver.
+    pub manifolds: usize,
+    /// Contact points handed to the solver.
+    pub contact_points: usize,
+    /// The dynamics report: woken and slept bodies, broken joints, detailed solver timings.
+    pub dynamics: StepReport,
+}
+
+impl World {
+    /// Advances the world by `dt` through the whole pipeline (see the module docs of
+    /// [`crate::pipeline`]). A non-finite or non-positive `dt` is rejected before anything
+    /// changes.
+    pub fn step(&mut self, dt: Real) -> Result<&PipelineReport> {
+        let dt = Self::check_dt("dt", dt)?;
+        let start = Instant::now();
+        self.sync(dt)?;
+        let t_sync = start.elapsed();
+
+        self.collision.update()?;
+        let ct = self.collision.timings();
+
+        let t = Instant::now();
+        self.gather();
+        let gather = t.elapsed();
+
+        let dyn_report = self.dynamics.step(dt, &mut self.contacts)?;
+
+        let t = Instant::now();
+        self.write_back();
+        let contacts = gather + t.elapsed();
+
+        let d = &dyn_report.timings;
+        self.report = PipelineReport {
+            timings: PipelineTimings {
+                sync: t_sync,
+                broadphase: ct.broadphase,
+                narrowphase: ct.narrowphase,
+                contacts,
+                solver: d.forces + d.prepare + d.warm_start + d.solve + d.relax + d.restitution,
+                integrate: d.integrate,
+                islands: d.islands + d.store,
+                total: start.elapsed(),
+            },
+            pairs: self.collision.narrowphase().len(),
+            manifolds: self.contacts.len(),
+            contact_points: self.contact_point_count(),
+            dynamics: dyn_report,
+        };
+        Ok(&self.report)
+    }
+
+    /// Bullet's `btDiscreteDynamicsWorld::stepSimulation(timeStep, maxSubSteps,
+    /// fixedTimeStep)`: adds `dt` to an accumulator and runs as many whole steps of
+    /// `fixed_step` as it holds, at most `max_sub_steps` (time beyond that is dropped, so a
+    /// slow frame does not snowball); the remainder waits for the next call
+    /// ([`World::accumulator`]). Returns the number of steps taken. With `max_sub_steps == 0`
+    /// it runs one step of `dt` instead (variable time step), as Bullet does.
+    ///
+    /// Interpolation-free: the body poses are those of the last completed fixed step, never
+    /// extrapolated by the leftover time (Bullet interpolates motion states; a renderer that
+    /// wants that can blend the last two poses by `accumulator() / fixed_step`).
+    pub fn step_simulation(
+        &mut self,
+        dt: Real,
+        max_sub_steps: u32,
+        fixed_step: Real,
+    ) -> Result<u32> {
+        if !(dt.is_finite() && dt >= 0.0) {
+            return Err(CaromError::invalid("dt", dt, "must be finite and >= 0"));
+        }
+        if max_sub_steps == 0 {
+            if dt > 0.0 {
+                self.step(dt)?;
+                return Ok(1);
+            }
+            return Ok(0);
+        }
+        let fixed = Self::check_dt("fixed_step", fixed_step)?;
+        self.accumulator += dt;
+        let whole = (self.accumulator / fixed).floor();
+        self.accumulator -= whole * fixed;
+        let n = (whole as u64).min(max_sub_steps as u64) as u32;
+        for _ in 0..n {
+            self.step(fixed)?;
+        }
+        Ok(n)
+    }
+
+    /// Copies the poses of moving bodies to their collision objects with speculative margins,
+    /// and the sleep state to the broadphase's resting hints.
+    pub(super) fn sync(&mut self, dt: Real) -> Result<()> {
+        let base = 0.5 * self.params.manifold.prediction;
+        let speculative = self.params.speculative;
+        for i in 0..self.object_of.len() {
+            let Some(obj) = self.object_of[i] else {
+                continue;
+            };
+            let set = self.dynamics.bodies();
+            let info = &set.info[i];
+            let moving = match info.body_type {
+                BodyType::Dynamic => !info.sleeping,
+                BodyType::Kinematic => true,
+                BodyType::Static => false,
+            };
+            let pose = set.pose_of(i);
+            if moving {
+                let motion = if speculative {
+                    let (v, w) = (set.linear_velocity[i], set.angular_velocity[i]);
+                    (v.length() + w.length() * self.radius[i]) * dt
+                } else {
+                    0.0
+                };
+                self.collision
+                    .set_pose_with_margin(obj, pose, base + motion)?;
+            } else if info.body_type == BodyType::Static && self.collision.get(obj)?.pose != pose {
+                // A static body teleported through `bodies_mut().set_pose`.
+                self.collision.set_pose(obj, pose)?;
+            }
+            let resting = !moving;
+            if resting != self.resting[i] {
+                self.collision.set_resting(obj, resting)?;
+                self.resting[i] = resting;
+            }
+        }
+        Ok(())
+    }
+}

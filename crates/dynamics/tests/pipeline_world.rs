@@ -1,0 +1,206 @@
+//! The World's bookkeeping: bad input, removal with joints, sub-stepping, sleeping with the
+//! broadphase's resting hints, scenes, timings.
+mod pipeline;
+use carom_dynamics::collision::math::{Isometry, Real, Vec3};
+use carom_dynamics::*;
+use carom_scenes::bullet;
+use pipeline::*;
+
+#[test]
+fn bad_input_is_rejected_with_the_value_named() {
+    let mut w = world(true);
+    ground(&mut w, 0.5);
+    let b = dyn_box(&mut w, Vec3::splat(0.5), Vec3::new(0.0, 0.5, 0.0));
+    for dt in [Real::NAN, Real::INFINITY, 0.0, -1.0] {
+        let e = w.step(dt).unwrap_err().to_string();
+        assert!(e.contains("dt"), "{e}");
+    }
+    let e = w
+        .step_simulation(Real::NAN, 4, 1.0 / 60.0)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("dt"), "{e}");
+    let e = w.step_simulation(0.1, 4, 0.0).unwrap_err().to_string();
+    assert!(e.contains("fixed_step"), "{e}");
+    let e = w
+        .bodies_mut()
+        .add_force(b, Vec3::new(Real::NAN, 0.0, 0.0))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("force"), "{e}");
+    let nan_pose = Isometry::from_translation(Vec3::new(0.0, Real::NAN, 0.0));
+    let e = w.set_pose(b, nan_pose).unwrap_err().to_string();
+    assert!(e.contains("pose"), "{e}");
+    for m in [0.0, -2.0, Real::NAN] {
+        let mut d = BodyDesc::dynamic(cuboid(Vec3::ONE), Isometry::IDENTITY, 1.0);
+        d.mass = MassSpec::Mass(m);
+        let e = w.add_body(&d).unwrap_err().to_string();
+        assert!(e.contains("mass"), "{e}");
+    }
+    let mut d = BodyDesc::dynamic(cuboid(Vec3::ONE), nan_pose, 1.0);
+    assert!(w.add_body(&d).unwrap_err().to_string().contains("pose"));
+    d.pose = Isometry::IDENTITY;
+    d.linear_velocity = Vec3::splat(Real::INFINITY);
+    assert!(w.add_body(&d).is_err());
+    // Nothing was half-created: one ground, one box, and the world still steps.
+    assert_eq!(w.bodies().len(), 2);
+    assert_eq!(w.collision().len(), 2);
+    w.step(1.0 / 60.0).unwrap();
+    assert!(pos(&w, b).is_finite());
+}
+
+#[test]
+fn removing_bodies_with_joints_between_steps_cannot_corrupt() {
+    let mut w = world(false);
+    ground(&mut w, 0.5);
+    let chain: Vec<BodyHandle> = (0..5)
+        .map(|i| {
+            dyn_box(
+                &mut w,
+                Vec3::splat(0.2),
+                Vec3::new(i as Real * 0.5, 2.0, 0.0),
+            )
+        })
+        .collect();
+    let mut joints = Vec::new();
+    for p in chain.windows(2) {
+        let desc = JointDesc {
+            body_a: p[0],
+            body_b: p[1],
+            frame_a: Isometry::from_translation(Vec3::new(0.25, 0.0, 0.0)),
+            frame_b: Isometry::from_translation(Vec3::new(-0.25, 0.0, 0.0)),
+            kind: JointKind::Ball,
+            break_impulse: Real::INFINITY,
+            disable_collisions: true,
+        };
+        joints.push(w.create_joint(&desc).unwrap());
+    }
+    for _ in 0..30 {
+        w.step(1.0 / 60.0).unwrap();
+    }
+    let removed = w.remove_body(chain[2]).unwrap();
+    assert_eq!(removed.len(), 2);
+    assert!(w.remove_body(chain[2]).is_err(), "stale handle");
+    assert!(w.bodies().pose(chain[2]).is_err());
+    assert!(w.remove_joint(removed[0]).is_err());
+    // A new body may reuse the slot; the stale handle still names nothing.
+    let fresh = dyn_box(&mut w, Vec3::splat(0.2), Vec3::new(5.0, 1.0, 0.0));
+    assert!(w.bodies().pose(chain[2]).is_err());
+    for _ in 0..120 {
+        w.step(1.0 / 60.0).unwrap();
+    }
+    for &b in chain.iter().filter(|&&b| b != chain[2]).chain([&fresh]) {
+        let p = pos(&w, b);
+        assert!(p.is_finite() && p.y > 0.0, "{b:?} at {p}");
+    }
+    // Every manifold handed to the solver names live bodies.
+    for pc in w.collision().narrowphase().pairs() {
+        assert!(w.body_of_object(pc.a).is_some() && w.body_of_object(pc.b).is_some());
+    }
+}
+
+#[test]
+fn step_simulation_accumulates_fixed_steps() {
+    let mut w = world(false);
+    let b = w
+        .add_body(&BodyDesc::dynamic(sphere(0.5), Isometry::IDENTITY, 1000.0))
+        .unwrap();
+    let h: Real = 1.0 / 60.0;
+    assert_eq!(w.step_simulation(0.5 * h, 4, h).unwrap(), 0);
+    assert_eq!(
+        pos(&w, b),
+        Vec3::ZERO,
+        "no step yet: poses are not extrapolated"
+    );
+    assert_eq!(w.step_simulation(0.6 * h, 4, h).unwrap(), 1);
+    assert!((w.accumulator() - 0.1 * h).abs() < 1e-5);
+    assert_eq!(w.step_simulation(2.0 * h, 4, h).unwrap(), 2);
+    // A long frame is clamped to max_sub_steps; the excess time is dropped.
+    assert_eq!(w.step_simulation(10.0 * h, 3, h).unwrap(), 3);
+    assert!(w.accumulator() < h);
+    // Free fall over the 6 fixed steps of `substeps` substeps each: symplectic Euler over
+    // m substeps of s gives y = -g s² m(m+1)/2.
+    let k = w.params().dynamics.solver.substeps as Real;
+    let (m, s) = (6.0 * k, h / k);
+    let expected = -10.0 * s * s * m * (m + 1.0) / 2.0;
+    assert!(
+        (pos(&w, b).y - expected).abs() < 1e-4,
+        "{} vs {expected}",
+        pos(&w, b).y
+    );
+    // max_sub_steps = 0: one variable step.
+    assert_eq!(w.step_simulation(0.5 * h, 0, h).unwrap(), 1);
+}
+
+#[test]
+fn resting_bodies_sleep_in_the_broadphase_and_wake_on_hit() {
+    let mut w = world(true);
+    ground(&mut w, 0.5);
+    let boxes: Vec<BodyHandle> = (0..3)
+        .map(|i| {
+            dyn_box(
+                &mut w,
+                Vec3::splat(0.5),
+                Vec3::new(0.0, 0.5 + i as Real, 0.0),
+            )
+        })
+        .collect();
+    for _ in 0..200 {
+        w.step(1.0 / 60.0).unwrap();
+    }
+    assert_eq!(w.sleeping_count(), 3);
+    w.step(1.0 / 60.0).unwrap();
+    for &b in &boxes {
+        let o = w.object(b).unwrap().unwrap();
+        assert!(w.collision().get(o).unwrap().resting, "{b:?} not resting");
+    }
+    let before: Vec<Vec3> = boxes.iter().map(|&b| pos(&w, b)).collect();
+    w.step(1.0 / 60.0).unwrap();
+    assert_eq!(
+        before,
+        boxes.iter().map(|&b| pos(&w, b)).collect::<Vec<_>>()
+    );
+    // A ball dropped on top wakes the stack through a real contact.
+    let ball = w
+        .add_body(&BodyDesc::dynamic(
+            sphere(0.3),
+            Isometry::from_translation(Vec3::new(0.1, 4.0, 0.0)),
+            1000.0,
+        ))
+        .unwrap();
+    let mut woken = Vec::new();
+    for _ in 0..60 {
+        woken.extend(w.step(1.0 / 60.0).unwrap().dynamics.woken.iter().copied());
+    }
+    for &b in &boxes {
+        assert!(woken.contains(&b), "{b:?} not woken");
+    }
+    assert!(
+        pos(&w, ball).y > 2.5,
+        "ball on top of the stack: {}",
+        pos(&w, ball).y
+    );
+}
+
+#[test]
+fn scene_builder_matches_the_scene_and_timings_are_reported() {
+    let scene = bullet::ragdolls();
+    let w = World::from_scene(&scene).unwrap();
+    assert_eq!(w.bodies().len(), scene.bodies.len());
+    assert_eq!(w.joints().len(), scene.joints.len());
+    for (h, b) in w.handles().iter().zip(&scene.bodies) {
+        let p = w.bodies().pose(*h).unwrap();
+        assert!((p.translation - b.pose.translation).length() < 1e-4);
+        assert_eq!(w.bodies().inv_mass(*h).unwrap() == 0.0, b.is_static());
+    }
+    let mut scene = bullet::falling_boxes();
+    scene.bodies.truncate(65);
+    let mut w = World::from_scene(&scene).unwrap();
+    let mut r = PipelineReport::default();
+    for _ in 0..100 {
+        r = w.step(scene.dt).unwrap().clone();
+    }
+    let t = r.timings;
+    assert!(t.total >= t.broadphase + t.narrowphase + t.solver);
+    assert!(r.manifolds > 0 && r.contact_points >= r.manifolds);
+}
