@@ -11,7 +11,7 @@ use serde::Serialize;
 pub const REST_SPEED: f64 = 0.1;
 
 /// Sanity figures of one run.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
 pub struct Sanity {
     /// Dynamic bodies.
     pub bodies: usize,
@@ -49,12 +49,7 @@ pub fn sanity(scene: &Scene, initial: &[BodyState], last: &[BodyState]) -> Sanit
     let floor = floor(scene);
     let mut s = Sanity {
         bodies: last.len(),
-        mean_height: 0.0,
-        resting: 0,
-        below_ground: 0,
-        max_drift: 0.0,
-        max_speed: 0.0,
-        non_finite: 0,
+        ..Sanity::default()
     };
     let norm = |v: [f64; 3]| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
     let mut finite = 0usize;

@@ -141,15 +141,7 @@ mod tests {
             ray_ms: vec![],
             stages: StageTimes::default(),
             hits: 0,
-            sanity: Sanity {
-                bodies: 0,
-                mean_height: 0.0,
-                resting: 0,
-                below_ground: 0,
-                max_drift: 0.0,
-                max_speed: 0.0,
-                non_finite: 0,
-            },
+            sanity: Sanity::default(),
         }
     }
 
