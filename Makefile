@@ -1,6 +1,7 @@
 # Carom: the two commands of the README, and the pieces they are made of.
 #   make demo   build and run a real example
 #   make test   every check CI runs (fmt, clippy, cargo test f32 + f64, Python package + pytest)
+#   make bench  Bullet's benchmark scenes: Carom, Rapier and Bullet (pybullet) side by side
 # Everything Python lives in a local venv (.venv) that these targets create.
 
 SHELL := /bin/bash
@@ -10,7 +11,7 @@ PY := $(VENV)/bin/python
 CARGO ?= cargo
 export CARGO_TERM_COLOR ?= never
 
-.PHONY: demo test fmt fmt-check lint rust-test rust-test-f64 python-test develop venv bench toolchain clean
+.PHONY: demo test fmt fmt-check lint rust-test rust-test-f64 python-test develop venv bench bench-venv toolchain clean
 
 toolchain:
 	@command -v $(CARGO) >/dev/null || { echo "error: cargo not found; install Rust (rustup) first"; exit 1; }
@@ -59,8 +60,22 @@ python-test: develop
 test: fmt-check lint rust-test rust-test-f64 python-test
 	@echo "make test: all checks passed"
 
-bench: toolchain
-	$(CARGO) run --release -p carom-bench --bin carom-bench -- all
+# The Bullet peer: pybullet from PyPI in its own venv (.venv-bench).
+BENCH_VENV ?= .venv-bench
+bench-venv: $(BENCH_VENV)/.ready
+
+$(BENCH_VENV)/.ready:
+	$(PYTHON) -m venv $(BENCH_VENV)
+	$(BENCH_VENV)/bin/python -m pip install --quiet --upgrade pip
+	$(BENCH_VENV)/bin/python -m pip install --quiet pybullet==3.2.7 numpy
+	touch $@
+
+# All eight scenes, sleeping off and on, 1 thread and all cores, 3 runs, every peer:
+# table on stdout, bench/results/scenes.{json,csv,png}. Extra options: BENCH_ARGS="--runs 1".
+BENCH_ARGS ?=
+bench: toolchain bench-venv
+	$(CARGO) run --release -p carom-bench --bin carom-bench -- scenes \
+		--python $(BENCH_VENV)/bin/python --out bench/results $(BENCH_ARGS)
 
 clean:
 	$(CARGO) clean

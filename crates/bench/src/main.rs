@@ -6,6 +6,7 @@ mod broadphase;
 mod cdtest;
 mod midphase;
 mod plot;
+mod scenes;
 
 use clap::{Parser, Subcommand};
 
@@ -29,6 +30,16 @@ enum Command {
         #[arg(trailing_var_arg = true, allow_hyphen_values = true)]
         args: Vec<String>,
     },
+    /// Bullet's benchmark scenes with Carom, Rapier and Bullet (pybullet) side by side.
+    Scenes(scenes::Args),
+    /// Writes one scene (name or number 1–8) as JSON, the input of the pybullet peer.
+    ExportScene {
+        /// Scene name ("1000 stack") or number.
+        name: String,
+        /// Output file (default: stdout).
+        #[arg(long)]
+        out: Option<std::path::PathBuf>,
+    },
 }
 
 fn main() {
@@ -39,9 +50,24 @@ fn main() {
             midphase::run(&args);
             Ok(())
         }
+        Command::Scenes(args) => scenes::run(&args),
+        Command::ExportScene { name, out } => export_scene(&name, out.as_deref()),
     };
     if let Err(e) = result {
         eprintln!("error: {e}");
         std::process::exit(1);
+    }
+}
+
+fn export_scene(name: &str, out: Option<&std::path::Path>) -> Result<(), String> {
+    let scene = scenes::find_scene(name).ok_or_else(|| format!("unknown scene {name:?}"))?;
+    let text =
+        serde_json::to_string(&scenes::export::scene_json(&scene)?).map_err(|e| e.to_string())?;
+    match out {
+        Some(path) => std::fs::write(path, text).map_err(|e| format!("{}: {e}", path.display())),
+        None => {
+            println!("{text}");
+            Ok(())
+        }
     }
 }

@@ -9,7 +9,8 @@ use std::sync::Once;
 
 static FONT: Once = Once::new();
 
-fn ensure_font() {
+/// Registers the bundled font (once).
+pub fn ensure_font() {
     FONT.call_once(|| {
         let bytes: &'static [u8] = include_bytes!("../assets/DejaVuSans.ttf");
         let _ = register_font("sans-serif", FontStyle::Normal, bytes);
