@@ -41,21 +41,69 @@ pub struct Penetration {
     pub point_b: Vec3,
 }
 
+/// A polytope face: vertex indices (counter-clockwise seen from outside), the face across
+/// each edge `idx[e] → idx[(e + 1) % 3]`, the outward unit normal and the plane's distance
+/// from the origin. Faces are never moved: removed ones are flagged, so adjacency indices
+/// stay valid (as in Bullet's `btGjkEpa2.cpp` and Jolt's `EPAConvexHullBuilder`).
 #[derive(Debug, Clone, Copy)]
 struct Face {
-    idx: [usize; 3],
+    idx: [u32; 3],
+    adj: [u32; 3],
     normal: Vec3,
     dist: Real,
+    removed: bool,
 }
 
+#[derive(Debug, Clone, Copy)]
 struct Vertex {
     w: Vec3,
     a: Vec3,
     b: Vec3,
 }
 
-fn make_face(verts: &[Vertex], idx: [usize; 3], tol: Real) -> Option<Face> {
-    let (p, q, r) = (verts[idx[0]].w, verts[idx[1]].w, verts[idx[2]].w);
+/// A horizon edge `i → j` of the visible region, and the kept face `outer` across it.
+#[derive(Debug, Clone, Copy)]
+struct HorizonEdge {
+    i: u32,
+    j: u32,
+    outer: u32,
+}
+
+/// The buffers of one EPA run, kept per thread so that steady-state calls do not allocate.
+#[derive(Default)]
+struct Scratch {
+    verts: Vec<Vertex>,
+    faces: Vec<Face>,
+    horizon: Vec<HorizonEdge>,
+    stack: Vec<(u32, u8)>,
+    /// Faces removed by the current expansion step (to undo it).
+    carved: Vec<u32>,
+    /// Per vertex: the new face whose horizon edge starts there, stamped with the step.
+    start_of: Vec<(u32, u32)>,
+    /// Stamp of the current stitching step (never `u32::MAX`, the "unset" stamp).
+    stamp: u32,
+}
+
+thread_local! {
+    static SCRATCH: std::cell::RefCell<Scratch> = std::cell::RefCell::new(Scratch::default());
+}
+
+/// Runs `f` with this thread's scratch buffers (fresh ones if they are already in use).
+fn with_scratch<R>(f: impl FnOnce(&mut Scratch) -> R) -> R {
+    SCRATCH.with(|cell| match cell.try_borrow_mut() {
+        Ok(mut s) => f(&mut s),
+        Err(_) => f(&mut Scratch::default()),
+    })
+}
+
+const NO_FACE: u32 = u32::MAX;
+
+fn make_face(verts: &[Vertex], idx: [u32; 3], tol: Real) -> Option<Face> {
+    let (p, q, r) = (
+        verts[idx[0] as usize].w,
+        verts[idx[1] as usize].w,
+        verts[idx[2] as usize].w,
+    );
     let n = (q - p).cross(r - p);
     let len = n.length();
     let edge = (q - p).length().max((r - p).length()).max((r - q).length());
@@ -65,8 +113,10 @@ fn make_face(verts: &[Vertex], idx: [usize; 3], tol: Real) -> Option<Face> {
     let normal = n / len;
     Some(Face {
         idx,
+        adj: [NO_FACE; 3],
         normal,
         dist: normal.dot(p),
+        removed: false,
     })
 }
 
@@ -95,8 +145,22 @@ pub fn epa_polytope<A: Support, B: Support>(
     b: &B,
     simplex: &Simplex,
 ) -> Option<Penetration> {
-    let diff = MinkowskiDiff { a, b };
-    let mut verts: Vec<Vertex> = Vec::with_capacity(EPA_MAX_ITERATIONS + 8);
+    with_scratch(|scratch| {
+        let diff = MinkowskiDiff { a, b };
+        let scale = initial_tetrahedron(&diff, simplex, scratch)?;
+        Some(expand(&diff, scratch, scale))
+    })
+}
+
+/// Grows GJK's final simplex to a tetrahedron of `A - B` points with adjacency; returns the
+/// polytope's scale, or `None` when the difference is flat.
+fn initial_tetrahedron<A: Support, B: Support>(
+    diff: &MinkowskiDiff<A, B>,
+    simplex: &Simplex,
+    scratch: &mut Scratch,
+) -> Option<Real> {
+    let verts = &mut scratch.verts;
+    verts.clear();
     for i in 0..simplex.len {
         verts.push(Vertex {
             w: simplex.w[i],
@@ -110,13 +174,13 @@ pub fn epa_polytope<A: Support, B: Support>(
         verts.push(Vertex { w, a: pa, b: pb });
     };
     if verts.is_empty() {
-        push(&mut verts, Vec3::X);
+        push(verts, Vec3::X);
     }
     let tol = 64.0 * EPSILON;
     // Grow to a segment.
     if verts.len() == 1 {
         for d in sample_directions() {
-            push(&mut verts, d);
+            push(verts, d);
             let len = (verts[1].w - verts[0].w).length();
             scale = scale.max(verts[1].w.length());
             if len > tol * scale.max(len) {
@@ -131,7 +195,7 @@ pub fn epa_polytope<A: Support, B: Support>(
         let (e1, e2) = crate::math::orthonormal_basis(d);
         for k in 0..6 {
             let ang = k as Real * (crate::math::consts::PI / 3.0);
-            push(&mut verts, e1 * ang.cos() + e2 * ang.sin());
+            push(verts, e1 * ang.cos() + e2 * ang.sin());
             let off = (verts[2].w - verts[0].w).cross(d).length();
             scale = scale.max(verts[2].w.length());
             if off > tol * scale {
@@ -142,14 +206,13 @@ pub fn epa_polytope<A: Support, B: Support>(
     }
     // Grow to a tetrahedron: an apex on the origin's side of the triangle first. (A
     // bipyramid would not be convex in general; EPA adds the other side itself.)
-    let mut faces: Vec<Face> = Vec::new();
     if verts.len() == 3 {
         let n = (verts[1].w - verts[0].w)
             .cross(verts[2].w - verts[0].w)
             .normalize_or_zero();
         let first = if n.dot(verts[0].w) > 0.0 { -n } else { n };
         for dir in [first, -first] {
-            push(&mut verts, dir);
+            push(verts, dir);
             let h = (verts[3].w - verts[0].w).dot(n).abs();
             scale = scale.max(verts[3].w.length());
             if n != Vec3::ZERO && h > tol * scale {
@@ -158,45 +221,46 @@ pub fn epa_polytope<A: Support, B: Support>(
             verts.pop();
         }
     }
-    if verts.len() == 4 {
-        build_faces(
-            &verts,
-            &[[0, 1, 2], [0, 1, 3], [0, 2, 3], [1, 2, 3]],
-            &mut faces,
-            tol,
-        );
-    }
-    if faces.is_empty() {
+    if verts.len() != 4 {
         return None;
     }
-    Some(expand(&diff, verts, faces, scale))
-}
-
-/// Adds the faces `tris`, oriented away from the polytope's centroid; clears `faces` if any
-/// face is degenerate.
-fn build_faces(verts: &[Vertex], tris: &[[usize; 3]], faces: &mut Vec<Face>, tol: Real) {
-    let n = tris.iter().flatten().max().map_or(0, |m| m + 1);
-    let centroid = verts[..n].iter().fold(Vec3::ZERO, |acc, v| acc + v.w) / n.max(1) as Real;
-    for &t in tris {
-        let Some(mut f) = make_face(verts, t, tol) else {
-            faces.clear();
-            return;
-        };
-        if f.normal.dot(centroid - verts[t[0]].w) > 0.0 {
-            f = make_face(verts, [t[0], t[2], t[1]], tol).expect("same triangle");
+    let faces = &mut scratch.faces;
+    faces.clear();
+    let centroid = verts.iter().fold(Vec3::ZERO, |acc, v| acc + v.w) * 0.25;
+    for t in [[0, 1, 2], [0, 1, 3], [0, 2, 3], [1, 2, 3]] {
+        let mut f = make_face(verts, t, tol)?;
+        if f.normal.dot(centroid - verts[t[0] as usize].w) > 0.0 {
+            f = make_face(verts, [t[0], t[2], t[1]], tol)?;
         }
         faces.push(f);
     }
+    // Adjacency of the tetrahedron: the face holding the reversed directed edge.
+    for fi in 0..4 {
+        for e in 0..3 {
+            let (i, j) = (faces[fi].idx[e], faces[fi].idx[(e + 1) % 3]);
+            faces[fi].adj[e] = (0..4)
+                .find(|&g| g != fi && edge_index(&faces[g], j, i).is_some())
+                .map_or(NO_FACE, |g| g as u32);
+        }
+    }
+    Some(scale)
+}
+
+/// The edge index `e` of `f` with `f.idx[e] == i` and `f.idx[e + 1] == j`.
+#[inline]
+fn edge_index(f: &Face, i: u32, j: u32) -> Option<usize> {
+    (0..3).find(|&e| f.idx[e] == i && f.idx[(e + 1) % 3] == j)
 }
 
 fn result_from_face(verts: &[Vertex], f: &Face) -> Penetration {
-    let tri = [verts[f.idx[0]].w, verts[f.idx[1]].w, verts[f.idx[2]].w];
+    let v = |k: usize| verts[f.idx[k] as usize];
+    let tri = [v(0).w, v(1).w, v(2).w];
     let sol = closest_to_origin(&tri);
     let mut pa = Vec3::ZERO;
     let mut pb = Vec3::ZERO;
     for k in 0..3 {
-        pa += verts[f.idx[k]].a * sol.lambda[k];
-        pb += verts[f.idx[k]].b * sol.lambda[k];
+        pa += v(k).a * sol.lambda[k];
+        pb += v(k).b * sol.lambda[k];
     }
     let depth = f.dist.max(0.0);
     Penetration {
@@ -207,23 +271,65 @@ fn result_from_face(verts: &[Vertex], f: &Face) -> Penetration {
     }
 }
 
+/// Removes the faces that see `w` (a connected region grown from `start` across shared
+/// edges, depth first) and records the horizon: the edges between removed and kept faces.
+/// Returns `false` when the adjacency is broken (round-off), leaving the polytope as is.
+fn carve_horizon(scratch: &mut Scratch, start: u32, w: Vec3, vis_eps: Real) -> bool {
+    let Scratch {
+        verts,
+        faces,
+        horizon,
+        stack,
+        carved,
+        ..
+    } = scratch;
+    let sees = |f: &Face| f.normal.dot(w - verts[f.idx[0] as usize].w) > vis_eps;
+    horizon.clear();
+    stack.clear();
+    carved.clear();
+    faces[start as usize].removed = true;
+    carved.push(start);
+    stack.push((start, 0));
+    while let Some(top) = stack.last_mut() {
+        let (fi, e) = *top;
+        if e == 3 {
+            stack.pop();
+            continue;
+        }
+        top.1 += 1;
+        let f = faces[fi as usize];
+        let g = f.adj[e as usize];
+        if g == NO_FACE {
+            return false;
+        }
+        if faces[g as usize].removed {
+            continue;
+        }
+        if sees(&faces[g as usize]) {
+            faces[g as usize].removed = true;
+            carved.push(g);
+            stack.push((g, 0));
+        } else {
+            horizon.push(HorizonEdge {
+                i: f.idx[e as usize],
+                j: f.idx[(e as usize + 1) % 3],
+                outer: g,
+            });
+        }
+    }
+    !horizon.is_empty()
+}
+
 fn expand<A: Support, B: Support>(
     diff: &MinkowskiDiff<A, B>,
-    mut verts: Vec<Vertex>,
-    mut faces: Vec<Face>,
+    scratch: &mut Scratch,
     mut scale: Real,
 ) -> Penetration {
     let tol = 64.0 * EPSILON;
-    let mut best = faces[0];
-    let mut edges: Vec<(usize, usize)> = Vec::new();
-    let mut new_faces: Vec<Face> = Vec::new();
-    let mut visible: Vec<bool> = Vec::new();
-    let mut stack: Vec<usize> = Vec::new();
+    let mut best_i = 0u32;
     for _ in 0..EPA_MAX_ITERATIONS {
-        best = *faces
-            .iter()
-            .min_by(|x, y| x.dist.total_cmp(&y.dist))
-            .expect("non-empty polytope");
+        best_i = closest_face(&scratch.faces);
+        let best = scratch.faces[best_i as usize];
         let (w, pa, pb) = diff.support_pair(best.normal);
         if !w.is_finite() {
             break;
@@ -233,92 +339,120 @@ fn expand<A: Support, B: Support>(
         if gap <= EPA_REL_TOL * scale.max(EPSILON) {
             break;
         }
-        let k = verts.len();
-        verts.push(Vertex { w, a: pa, b: pb });
-        // Faces that see w, by flood fill from the best face across shared edges, so the
-        // removed region is connected and its boundary is one horizon loop.
         let vis_eps = EPSILON * scale;
-        let sees = |f: &Face| f.normal.dot(w - verts[f.idx[0]].w) > vis_eps;
-        visible.clear();
-        visible.resize(faces.len(), false);
-        let start = faces
-            .iter()
-            .position(|f| f.idx == best.idx)
-            .expect("best is a face");
-        visible[start] = true;
-        stack.clear();
-        stack.push(start);
-        edges.clear();
-        while let Some(fi) = stack.pop() {
-            let f = faces[fi];
-            for e in 0..3 {
-                let (i, j) = (f.idx[e], f.idx[(e + 1) % 3]);
-                let neighbour = faces.iter().position(|g| {
-                    (g.idx[0] == j && g.idx[1] == i)
-                        || (g.idx[1] == j && g.idx[2] == i)
-                        || (g.idx[2] == j && g.idx[0] == i)
-                });
-                match neighbour {
-                    Some(g) if visible[g] => {}
-                    Some(g) if sees(&faces[g]) => {
-                        visible[g] = true;
-                        stack.push(g);
-                    }
-                    _ => edges.push((i, j)),
-                }
-            }
-        }
-        // Horizon edges whose far side turned visible later are interior after all.
-        let horizon: Vec<(usize, usize)> = edges
-            .iter()
-            .copied()
-            .filter(|&(i, j)| {
-                !faces.iter().enumerate().any(|(g, f)| {
-                    visible[g]
-                        && ((f.idx[0] == j && f.idx[1] == i)
-                            || (f.idx[1] == j && f.idx[2] == i)
-                            || (f.idx[2] == j && f.idx[0] == i))
-                })
-            })
-            .collect();
-        new_faces.clear();
-        let mut ok = !horizon.is_empty();
-        for &(i, j) in &horizon {
-            match make_face(&verts, [i, j, k], tol) {
-                // EPA's lower bound never decreases; a closer new face means round-off
-                // has broken convexity: stop with the best face so far.
-                Some(f) if f.dist >= best.dist - EPA_REL_TOL * scale - vis_eps => new_faces.push(f),
-                _ => {
-                    ok = false;
-                    break;
-                }
-            }
-        }
-        if !ok {
+        let saved_faces = scratch.faces.len();
+        if !carve_horizon(scratch, best_i, w, vis_eps) {
+            restore(scratch, saved_faces);
             break;
         }
-        let mut g = 0;
-        faces.retain(|_| {
-            g += 1;
-            !visible[g - 1]
-        });
-        faces.append(&mut new_faces);
+        let k = scratch.verts.len() as u32;
+        scratch.verts.push(Vertex { w, a: pa, b: pb });
+        if !stitch(scratch, k, best.dist - EPA_REL_TOL * scale - vis_eps, tol) {
+            // EPA's lower bound never decreases and every horizon vertex starts one edge;
+            // otherwise round-off has broken convexity: stop with the best face so far.
+            scratch.verts.pop();
+            restore(scratch, saved_faces);
+            break;
+        }
     }
     // Coplanar faces tie on distance; the origin's projection lies inside only one of them.
     // Among the faces within tolerance of the best, take the one whose triangle is truly
     // closest to the origin, so the witnesses satisfy `a - b = depth * normal`.
+    let (verts, faces) = (&scratch.verts, &scratch.faces);
+    let best = faces[best_i as usize];
     let slack = EPA_REL_TOL * scale.max(EPSILON) * 4.0;
     let mut pick = best;
     let mut pick_d = Real::INFINITY;
-    for f in faces.iter().filter(|f| f.dist <= best.dist + slack) {
-        let tri = [verts[f.idx[0]].w, verts[f.idx[1]].w, verts[f.idx[2]].w];
+    for f in faces
+        .iter()
+        .filter(|f| !f.removed && f.dist <= best.dist + slack)
+    {
+        let tri = [
+            verts[f.idx[0] as usize].w,
+            verts[f.idx[1] as usize].w,
+            verts[f.idx[2] as usize].w,
+        ];
         let d = closest_to_origin(&tri).point(&tri).length_squared();
         if d < pick_d {
             pick_d = d;
             pick = *f;
         }
     }
-    result_from_face(&verts, &pick)
+    result_from_face(verts, &pick)
+}
+
+/// The live face closest to the origin (first on ties, so the result is deterministic).
+fn closest_face(faces: &[Face]) -> u32 {
+    let mut best = (Real::INFINITY, 0u32);
+    for (i, f) in faces.iter().enumerate() {
+        if !f.removed && f.dist < best.0 {
+            best = (f.dist, i as u32);
+        }
+    }
+    best.1
+}
+
+/// Connects the new vertex `k` to every horizon edge, linking the new faces to the kept
+/// ones and to each other. `false` (nothing linked) when a new face is degenerate, closer
+/// than `min_dist`, or the horizon is not one simple loop.
+fn stitch(scratch: &mut Scratch, k: u32, min_dist: Real, tol: Real) -> bool {
+    scratch.stamp = scratch.stamp.wrapping_add(1);
+    if scratch.stamp == u32::MAX {
+        scratch.stamp = 0;
+        scratch.start_of.clear();
+    }
+    let stamp = scratch.stamp;
+    let Scratch {
+        verts,
+        faces,
+        horizon,
+        start_of,
+        ..
+    } = scratch;
+    if start_of.len() < verts.len() {
+        start_of.resize(verts.len(), (u32::MAX, NO_FACE));
+    }
+    let first_new = faces.len() as u32;
+    for (n, h) in horizon.iter().enumerate() {
+        match make_face(verts, [h.i, h.j, k], tol) {
+            Some(f) if f.dist >= min_dist => faces.push(f),
+            _ => return false,
+        }
+        if start_of[h.i as usize].0 == stamp {
+            return false;
+        }
+        start_of[h.i as usize] = (stamp, first_new + n as u32);
+    }
+    // Check everything before changing any kept face.
+    for h in horizon.iter() {
+        if start_of[h.j as usize].0 != stamp
+            || edge_index(&faces[h.outer as usize], h.j, h.i).is_none()
+        {
+            return false;
+        }
+    }
+    for (n, h) in horizon.iter().enumerate() {
+        let fi = first_new + n as u32;
+        let next = start_of[h.j as usize].1;
+        let e_outer = edge_index(&faces[h.outer as usize], h.j, h.i).unwrap_or(0);
+        faces[fi as usize].adj = [h.outer, next, NO_FACE];
+        faces[h.outer as usize].adj[e_outer] = fi;
+    }
+    for n in 0..horizon.len() {
+        let fi = first_new + n as u32;
+        let next = faces[fi as usize].adj[1];
+        faces[next as usize].adj[2] = fi;
+    }
+    true
+}
+
+/// Undoes a failed expansion step: drops the faces added after `len` and revives the faces
+/// carved for it (`stitch` changes no kept face before all its checks have passed).
+fn restore(scratch: &mut Scratch, len: usize) {
+    scratch.faces.truncate(len);
+    for &fi in &scratch.carved {
+        scratch.faces[fi as usize].removed = false;
+    }
 }
 
 /// Sampled penetration depth: the smallest support extent of `A - B` over fixed directions
