@@ -129,7 +129,12 @@ impl CollisionWorld {
     ) -> Result<ObjectHandle> {
         let pose = check_isometry("pose", pose)?;
         if !shape.is_convex() {
+            // Only pairs that can ever meet need an algorithm: two static objects, or
+            // filters that exclude each other, never reach the narrowphase.
             for o in self.objects.iter().flatten() {
+                if !filter.can_pair(&o.filter) {
+                    continue;
+                }
                 self.narrowphase.dispatcher.check_pair(&shape, &o.shape)?;
             }
         }

@@ -79,7 +79,10 @@ pub type EngineBuilder = fn(&Scene, EngineConfig) -> Result<Box<dyn Engine>, Str
 
 /// The in-process engines, by name.
 pub fn builders() -> Vec<(&'static str, EngineBuilder)> {
-    vec![("rapier", super::rapier_peer::build as EngineBuilder)]
+    vec![
+        ("carom", super::carom_engine::build as EngineBuilder),
+        ("rapier", super::rapier_peer::build as EngineBuilder),
+    ]
 }
 
 /// The initial state of a scene's dynamic bodies (positions, zero velocity).

@@ -6,6 +6,7 @@
 //! `--check` runs a few steps per scene and checks the sanity figures instead of timing.
 
 pub mod bullet_peer;
+pub mod carom_engine;
 pub mod chart;
 pub mod engine;
 pub mod export;
