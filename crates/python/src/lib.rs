@@ -22,6 +22,7 @@ mod queries;
 mod serialize;
 mod shape;
 mod shapes;
+mod world;
 
 use pyo3::prelude::*;
 
@@ -55,5 +56,6 @@ fn _carom(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<broadphase::PyBroadPhase>()?;
     m.add_class::<dynamic_tree::PyDynamicTree>()?;
     collision_world::register(m)?;
+    m.add_class::<world::PyWorld>()?;
     Ok(())
 }
