@@ -83,11 +83,15 @@ fn unsupported_pair_is_rejected_when_added() {
     let plane = Arc::new(Shape::Plane(Plane::new(Vec3::Y, 0.0).unwrap()));
     w.add(plane.clone(), Isometry::IDENTITY, Filter::new(true))
         .unwrap();
+    // A movable plane could meet the static one: no algorithm, an error naming it.
     let err = w
-        .add(plane, Isometry::IDENTITY, Filter::new(true))
+        .add(plane.clone(), Isometry::IDENTITY, Filter::default())
         .unwrap_err();
     assert!(err.to_string().contains("plane"), "{err}");
     assert_eq!(w.len(), 1);
+    // Two static objects never pair: accepted.
+    w.add(plane, Isometry::IDENTITY, Filter::new(true)).unwrap();
+    assert_eq!(w.len(), 2);
 }
 
 fn pile(threads: usize) -> Vec<(u32, u32, Vec<[Real; 4]>)> {

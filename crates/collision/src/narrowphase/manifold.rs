@@ -56,11 +56,11 @@ pub struct ContactManifold {
 }
 
 /// Relative rotation (radians) under which a manifold's points are reused unchanged.
-pub const COHERENCE_ANGLE: Real = 1.0 * crate::math::consts::PI / 180.0;
+pub const COHERENCE_ANGLE: Real = 0.1 * crate::math::consts::PI / 180.0;
 
 /// Relative displacement (length units) of every contact point under which a manifold's
 /// points are reused unchanged.
-pub const COHERENCE_DISTANCE: Real = 1.0e-3;
+pub const COHERENCE_DISTANCE: Real = 1.0e-4;
 
 impl ContactManifold {
     /// An empty manifold.
