@@ -98,3 +98,8 @@ __all__ = [
 from carom._carom import BroadPhase, DynamicTree, overlapping_pairs  # noqa: E402
 
 __all__ += ["BroadPhase", "DynamicTree", "overlapping_pairs"]
+
+# Rigid-body simulation: bodies, the step pipeline, numpy state in bulk.
+from carom._carom import World  # noqa: E402
+
+__all__ += ["World"]

@@ -12,7 +12,7 @@ use crate::errors::{core, invalid};
 use crate::pose::{extract_isometry, extract_poses, Pose64};
 use crate::queries::shape_arg;
 use carom_collision::broadphase::{Filter, Method};
-use carom_collision::math::{Isometry, Real};
+use carom_collision::math::{check_finite_vec, Isometry, Real};
 use carom_dynamics::{BodyDesc, BodyHandle, BodyType, MassSpec, PipelineParams, World};
 use numpy::ndarray::Array2;
 use numpy::IntoPyArray;
@@ -275,6 +275,10 @@ impl PyWorld {
                 lin.len(),
                 ang.len()
             )));
+        }
+        for (i, (v, w)) in lin.iter().zip(&ang).enumerate() {
+            core(|| check_finite_vec(&format!("linear[{i}]"), *v).map(|_| ()))?;
+            core(|| check_finite_vec(&format!("angular[{i}]"), *w).map(|_| ()))?;
         }
         let hs = self.handles_arg(Some(handles))?;
         let bodies = self.world.bodies_mut();
