@@ -7,7 +7,7 @@
 //! Each measurement loops over the same 64 poses for both libraries. parry3d uses glam 0.33:
 //! values are converted through arrays once, outside the timed loops.
 
-use carom_collision::math::{vec3_to_f64, Isometry, Quat, Real, Vec3};
+use carom_collision::math::{Isometry, Real, Vec3};
 use carom_collision::query;
 use carom_collision::shape::{Capsule, ConvexHull, Cuboid, Shape, Sphere, Triangle};
 use criterion::{criterion_group, criterion_main, Criterion};
@@ -16,41 +16,10 @@ use parry3d::query::{Ray as PRay, ShapeCastOptions};
 use parry3d::shape::SharedShape;
 use std::hint::black_box;
 
+mod common;
+use common::{pp, pv, Rng};
+
 const N: usize = 64;
-
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> Real {
-        self.0 = self
-            .0
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        ((self.0 >> 11) as f64 / (1u64 << 53) as f64) as Real
-    }
-    fn unit(&mut self) -> Vec3 {
-        loop {
-            let v = Vec3::new(self.next(), self.next(), self.next()) * 2.0 - Vec3::ONE;
-            let l = v.length();
-            if l > 0.1 && l <= 1.0 {
-                return v / l;
-            }
-        }
-    }
-    fn quat(&mut self) -> Quat {
-        Quat::from_axis_angle(self.unit(), self.next() * 6.0)
-    }
-}
-
-fn pv(v: Vec3) -> PVec3 {
-    let a = vec3_to_f64(v);
-    PVec3::new(a[0] as f32, a[1] as f32, a[2] as f32)
-}
-
-#[allow(clippy::unnecessary_cast)] // a no-op in the f32 build, a conversion in the f64 build
-fn pp(p: &Isometry) -> PPose {
-    let q = p.rotation.to_array().map(|x| x as f32);
-    PPose::from_parts(pv(p.translation), parry3d::math::Rot3::from_array(q))
-}
 
 struct Case {
     name: String,
