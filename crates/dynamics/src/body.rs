@@ -11,10 +11,11 @@ use carom_collision::math::{
 };
 use carom_collision::shape::{MassProperties, Shape};
 use carom_collision::{CaromError, Result};
+use serde::{Deserialize, Serialize};
 use std::sync::Arc;
 
 /// How a body moves.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
 pub enum BodyType {
     /// Moved by forces, contacts and joints.
     #[default]

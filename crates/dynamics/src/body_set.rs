@@ -11,10 +11,11 @@ use crate::body::{BodyDesc, BodyType};
 use carom_collision::math::{check_finite_vec, Isometry, Mat3, Quat, Real, Vec3};
 use carom_collision::shape::Shape;
 use carom_collision::{CaromError, Result};
+use serde::{Deserialize, Serialize};
 use std::sync::Arc;
 
 /// A stable reference to a body: slot index plus the generation of that slot.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
 pub struct BodyHandle {
     /// Slot index in the body arrays.
     pub index: u32,
@@ -23,11 +24,12 @@ pub struct BodyHandle {
 }
 
 /// Cold per-body data.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct BodyInfo {
     /// Dynamic, kinematic or static.
     pub body_type: BodyType,
-    /// Collision shape, if any.
+    /// Collision shape, if any (snapshots store shapes once, beside the set).
+    #[serde(skip)]
     pub shape: Option<Arc<Shape>>,
     /// Mass (0 for non-dynamic bodies).
     pub mass: Real,
@@ -61,7 +63,7 @@ pub struct BodyInfo {
 
 /// All bodies of a world. Hot data is public read-only through accessors; the arrays are
 /// indexed by [`BodyHandle::index`] and contain dead slots (zero inverse mass).
-#[derive(Debug, Clone, Default)]
+#[derive(Debug, Clone, Default, Serialize, Deserialize)]
 pub struct BodySet {
     generation: Vec<u32>,
     alive: Vec<bool>,
@@ -155,6 +157,56 @@ impl BodySet {
         Ok(())
     }
 
+    /// Checks the consistency of a decoded set (a snapshot): equal array lengths, free slots
+    /// in range, unique and dead, woken slots in range, finite states.
+    pub(crate) fn check_structure(&self) -> Result<()> {
+        let n = self.generation.len();
+        let lens = [
+            self.alive.len(),
+            self.position.len(),
+            self.rotation.len(),
+            self.linear_velocity.len(),
+            self.angular_velocity.len(),
+            self.inv_mass.len(),
+            self.inv_inertia_world.len(),
+            self.force.len(),
+            self.torque.len(),
+            self.info.len(),
+        ];
+        let bad = |what: &str, v: String| Err(CaromError::invalid("snapshot.bodies", v, what));
+        if lens.iter().any(|&l| l != n) {
+            return bad("arrays of different lengths", format!("{n} vs {lens:?}"));
+        }
+        let mut seen = vec![false; n];
+        for &f in &self.free {
+            let f = f as usize;
+            if f >= n || self.alive[f] || seen[f] {
+                return bad("bad free slot", f.to_string());
+            }
+            seen[f] = true;
+        }
+        if self.free.len() + self.alive.iter().filter(|&&a| a).count() != n {
+            return bad("free list does not cover the dead slots", n.to_string());
+        }
+        if let Some(&w) = self.woken_by_user.iter().find(|&&w| w >= n) {
+            return bad("woken slot out of range", w.to_string());
+        }
+        for i in 0..n {
+            let finite = self.position[i].is_finite()
+                && self.rotation[i].is_finite()
+                && self.linear_velocity[i].is_finite()
+                && self.angular_velocity[i].is_finite()
+                && self.force[i].is_finite()
+                && self.torque[i].is_finite()
+                && self.inv_mass[i].is_finite()
+                && self.inv_inertia_world[i].is_finite();
+            if !finite {
+                return bad("non-finite body state", format!("slot {i}"));
+            }
+        }
+        Ok(())
+    }
+
     /// The slot of a live handle, or [`CaromError::UnknownHandle`].
     pub fn slot(&self, h: BodyHandle) -> Result<usize> {
         let i = h.index as usize;
@@ -197,6 +249,11 @@ impl BodySet {
             index: i as u32,
             generation: self.generation[i],
         }
+    }
+
+    /// True when `i` is in range and names a live slot.
+    pub(crate) fn is_alive_checked(&self, i: usize) -> bool {
+        i < self.alive.len() && self.alive[i]
     }
 
     pub(crate) fn is_alive(&self, i: usize) -> bool {

@@ -13,9 +13,10 @@ use crate::contact::ContactManifold;
 use crate::joint::JointSet;
 use carom_collision::math::{check_non_negative, Real, Vec3};
 use carom_collision::Result;
+use serde::{Deserialize, Serialize};
 
 /// When bodies fall asleep.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct SleepParams {
     /// Allow sleeping at all.
     pub enabled: bool,

@@ -13,10 +13,11 @@ use crate::joint::{JointDesc, JointHandle, JointSet};
 use crate::solver::{self, SolverBody, SolverKind, SolverParams, StepContext, StepTimings};
 use carom_collision::math::{check_finite_vec, Real, Vec3};
 use carom_collision::{CaromError, Result};
+use serde::{Deserialize, Serialize};
 use std::time::Instant;
 
 /// World settings.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct WorldParams {
     /// Gravity, m/s².
     pub gravity: Vec3,
@@ -73,6 +74,23 @@ impl DynamicsWorld {
         Ok(DynamicsWorld {
             bodies: BodySet::new(),
             joints: JointSet::default(),
+            params,
+            solver_bodies: Vec::new(),
+        })
+    }
+
+    /// A world made of restored parts (a snapshot): the structure of both sets is checked.
+    pub(crate) fn from_parts(
+        params: WorldParams,
+        bodies: BodySet,
+        joints: JointSet,
+    ) -> Result<Self> {
+        Self::check_params(&params)?;
+        bodies.check_structure()?;
+        joints.check_structure()?;
+        Ok(DynamicsWorld {
+            bodies,
+            joints,
             params,
             solver_bodies: Vec::new(),
         })

@@ -243,6 +243,16 @@ impl<H: Copy + Ord + Send + Sync> NarrowPhase<H> {
         self.pairs.values_mut().filter(|p| !p.manifold.is_empty())
     }
 
+    /// Every pair, mutable, in pair order (to restore saved manifolds from a snapshot).
+    pub fn pairs_mut(&mut self) -> impl Iterator<Item = &mut PairContact<H>> {
+        self.pairs.values_mut()
+    }
+
+    /// Replaces the events of the last step (to restore a snapshot).
+    pub fn restore_events(&mut self, events: Vec<ContactEvent<H>>) {
+        self.events = events;
+    }
+
     /// The pair `(a, b)`.
     pub fn get(&self, a: H, b: H) -> Option<&PairContact<H>> {
         self.pairs.get(&(a, b))

@@ -15,9 +15,10 @@ pub(crate) use build::{build_rows, JointRows, ROW_SLOTS};
 use crate::body_set::BodyHandle;
 use carom_collision::math::{check_finite, check_isometry, check_non_negative, Isometry, Real};
 use carom_collision::{CaromError, Result};
+use serde::{Deserialize, Serialize};
 
 /// A velocity motor: drives the joint coordinate at `speed` with at most `max_force`.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Motor {
     /// Target speed (rad/s or m/s).
     pub speed: Real,
@@ -26,7 +27,7 @@ pub struct Motor {
 }
 
 /// A spring on one coordinate: frequency, damping ratio and rest value.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Spring {
     /// Stiffness as a frequency, Hz.
     pub hertz: Real,
@@ -37,7 +38,7 @@ pub struct Spring {
 }
 
 /// How one axis of a generic 6-DOF joint moves.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
 pub enum AxisMode {
     /// No relative motion.
     #[default]
@@ -54,7 +55,7 @@ pub enum AxisMode {
 }
 
 /// One axis of a generic 6-DOF joint.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
 pub struct Axis {
     /// Locked, free or limited.
     pub mode: AxisMode,
@@ -66,7 +67,7 @@ pub struct Axis {
 
 /// The type and parameters of a joint.
 #[allow(clippy::large_enum_variant)]
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub enum JointKind {
     /// Point-to-point: the frame origins coincide, rotation is free.
     Ball,
@@ -106,7 +107,7 @@ pub enum JointKind {
 }
 
 /// Everything needed to create a joint.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct JointDesc {
     /// First body.
     pub body_a: BodyHandle,
@@ -224,7 +225,7 @@ impl JointDesc {
 }
 
 /// A stable reference to a joint.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
 pub struct JointHandle {
     /// Slot index.
     pub index: u32,
@@ -233,7 +234,7 @@ pub struct JointHandle {
 }
 
 /// A live joint.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct Joint {
     /// Its description.
     pub desc: JointDesc,
@@ -244,7 +245,7 @@ pub struct Joint {
 }
 
 /// All joints of a world.
-#[derive(Debug, Clone, Default)]
+#[derive(Debug, Clone, Default, Serialize, Deserialize)]
 pub struct JointSet {
     slots: Vec<(u32, Option<Joint>)>,
     free: Vec<u32>,
@@ -324,6 +325,42 @@ impl JointSet {
 
     pub(crate) fn get_index_mut(&mut self, i: usize) -> Option<&mut Joint> {
         self.slots.get_mut(i).and_then(|s| s.1.as_mut())
+    }
+
+    /// Checks the consistency of a decoded set (a snapshot): free slots in range, unique and
+    /// empty; every joint description valid.
+    pub(crate) fn check_structure(&self) -> Result<()> {
+        let n = self.slots.len();
+        let mut seen = vec![false; n];
+        for &f in &self.free {
+            let f = f as usize;
+            if f >= n || self.slots[f].1.is_some() || seen[f] {
+                return Err(CaromError::invalid(
+                    "snapshot.joints",
+                    f,
+                    "bad free joint slot",
+                ));
+            }
+            seen[f] = true;
+        }
+        if self.free.len() + self.slots.iter().filter(|s| s.1.is_some()).count() != n {
+            return Err(CaromError::invalid(
+                "snapshot.joints",
+                n,
+                "free list does not cover the empty slots",
+            ));
+        }
+        for (_, j) in self.iter() {
+            j.desc.validate()?;
+            if j.impulses.iter().any(|x| !x.is_finite()) {
+                return Err(CaromError::invalid(
+                    "snapshot.joints",
+                    format!("{:?}", j.impulses),
+                    "non-finite joint impulse",
+                ));
+            }
+        }
+        Ok(())
     }
 
     /// Number of live joints.

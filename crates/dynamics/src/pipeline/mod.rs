@@ -42,8 +42,10 @@
 
 mod contacts;
 mod scene;
+mod snapshot;
 mod step;
 
+pub use snapshot::{SNAPSHOT_MAGIC, SNAPSHOT_VERSION};
 pub use step::{PipelineReport, PipelineTimings};
 
 use crate::body::{BodyDesc, BodyType};

@@ -31,9 +31,10 @@ use crate::joint::JointSet;
 
 use carom_collision::math::{check_non_negative, check_positive, Mat3, Real, Vec3};
 use carom_collision::{CaromError, Result};
+use serde::{Deserialize, Serialize};
 
 /// Which solver [`crate::DynamicsWorld::step`] uses.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 pub enum SolverKind {
     /// Sequential impulses with split impulses (Bullet).
     SequentialImpulse,
@@ -43,7 +44,7 @@ pub enum SolverKind {
 }
 
 /// Solver settings. Defaults follow Bullet (sequential impulses) and Box2D v3 (soft step).
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct SolverParams {
     /// Which solver.
     pub kind: SolverKind,
