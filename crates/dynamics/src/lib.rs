@@ -56,6 +56,9 @@ pub use island::SleepParams;
 pub use joint::{
     Axis, AxisMode, Joint, JointDesc, JointHandle, JointKind, JointSet, Motor, Spring,
 };
-pub use pipeline::{PipelineParams, PipelineReport, PipelineTimings, World};
+pub use pipeline::{
+    BodyRayHit, BodyShapeCastHit, PipelineParams, PipelineReport, PipelineTimings, World,
+    WorldQuery,
+};
 pub use solver::{SolverKind, SolverParams, StepTimings};
 pub use world::{DynamicsWorld, StepReport, WorldParams};

@@ -4,20 +4,15 @@
 //! narrowphase + contact adaptation; solver = solver + islands; integration = integrate).
 //! Sleeping follows the config; threads run the step inside a rayon pool of that size.
 //!
-//! Rays: `CollisionWorld` has no scene-level ray query yet, so each batch builds a midphase
-//! [`Bvh`] over the objects' current boxes (counted in the ray time) and casts every ray
-//! closest-first through it with `query::raycast` on the candidates; the batch runs in
-//! chunks of 20 rays on the pool (Bullet's `btParallelFor` grain).
+//! Rays: each batch builds the world's query structure (`World::query`: a BVH over the
+//! bodies' current boxes, counted in the ray time) and casts every ray closest-first through
+//! it; the batch runs in chunks of 20 rays on the pool (Bullet's `btParallelFor` grain).
 
 use super::engine::{BodyState, Engine, EngineConfig, StageTimes};
-use carom_collision::math::{Aabb, Isometry, Real, Vec3};
-use carom_collision::midphase::{Bvh, BvhLayout};
-use carom_collision::query::raycast;
-use carom_collision::shape::Shape;
+use carom_collision::math::{Real, Vec3};
 use carom_dynamics::{BodyHandle, PipelineParams, World};
 use carom_scenes::Scene;
 use rayon::prelude::*;
-use std::sync::Arc;
 
 const RAY_GRAIN: usize = 20;
 
@@ -86,32 +81,13 @@ impl Engine for CaromEngine {
         if self.rays.is_empty() {
             return 0;
         }
-        let objects: Vec<(Arc<Shape>, Isometry, Aabb)> = self
-            .world
-            .collision()
-            .iter()
-            .map(|(_, o)| (o.shape.clone(), o.pose, o.aabb))
-            .collect();
-        let boxes: Vec<Aabb> = objects.iter().map(|o| o.2).collect();
-        let Ok(bvh) = Bvh::new(&boxes, BvhLayout::default()) else {
+        let Ok(query) = self.world.query() else {
             return 0;
         };
         let cast = |&(from, to): &(Vec3, Vec3)| {
             let d = to - from;
             let len = d.length();
-            let dir = d / len;
-            let mut best: Option<Real> = None;
-            bvh.for_each_candidate_on_ray_ordered(from, dir, len, |i, max_t| {
-                let (shape, pose, _) = &objects[i as usize];
-                if let Ok(Some(hit)) = raycast(shape, pose, from, dir, *max_t, true) {
-                    if hit.distance <= *max_t {
-                        *max_t = hit.distance;
-                        best = Some(hit.distance);
-                    }
-                }
-                true
-            });
-            best.is_some()
+            matches!(query.raycast(from, d, len, u32::MAX), Ok(Some(_)))
         };
         if self.pool.current_num_threads() == 1 {
             return self.rays.iter().filter(|r| cast(r)).count();

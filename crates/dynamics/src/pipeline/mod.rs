@@ -41,10 +41,12 @@
 //! its own speed.
 
 mod contacts;
+mod queries;
 mod scene;
 mod snapshot;
 mod step;
 
+pub use queries::{BodyRayHit, BodyShapeCastHit, WorldQuery};
 pub use snapshot::{SNAPSHOT_MAGIC, SNAPSHOT_VERSION};
 pub use step::{PipelineReport, PipelineTimings};
 

@@ -1,0 +1,262 @@
+//! Ray and shape casts through the World against the brute force over every body with
+//! `query::raycast` / `query::shape_cast`: random rays (hit rate guarded), rays grazing faces,
+//! starting inside bodies, infinite length, far from the origin, masks, teleported bodies.
+mod pipeline;
+use carom_dynamics::collision::math::{Isometry, Quat, Real, Vec3};
+use carom_dynamics::collision::query::{raycast, shape_cast};
+use carom_dynamics::collision::shape::{Capsule, Shape};
+use carom_dynamics::*;
+use pipeline::*;
+use std::sync::Arc;
+
+struct Lcg(u64);
+impl Lcg {
+    fn next(&mut self) -> Real {
+        self.0 = self
+            .0
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        ((self.0 >> 11) as f64 / (1u64 << 53) as f64) as Real
+    }
+    fn range(&mut self, lo: Real, hi: Real) -> Real {
+        lo + (hi - lo) * self.next()
+    }
+}
+
+fn scene(offset: Vec3, rng: &mut Lcg) -> (World, Vec<BodyHandle>) {
+    let mut w = world(false);
+    let mut hs = vec![w
+        .add_body(&BodyDesc::fixed(
+            cuboid(Vec3::new(20.0, 0.5, 20.0)),
+            Isometry::from_translation(offset - Vec3::Y * 0.5),
+        ))
+        .unwrap()];
+    let capsule: Arc<Shape> = Arc::new(Capsule::new(0.2, 0.4).unwrap().into());
+    for i in 0..60 {
+        let shape = match i % 3 {
+            0 => sphere(rng.range(0.1, 0.6)),
+            1 => cuboid(Vec3::new(rng.range(0.1, 0.6), rng.range(0.1, 0.6), 0.3)),
+            _ => capsule.clone(),
+        };
+        let p = offset
+            + Vec3::new(
+                rng.range(-8.0, 8.0),
+                rng.range(0.5, 6.0),
+                rng.range(-8.0, 8.0),
+            );
+        let q =
+            Quat::from_rotation_y(rng.range(0.0, 6.0)) * Quat::from_rotation_x(rng.range(0.0, 3.0));
+        let mut d = BodyDesc::dynamic(shape, Isometry::new(p, q), 500.0);
+        d.filter.group = if i % 4 == 0 { 2 } else { 1 };
+        hs.push(w.add_body(&d).unwrap());
+    }
+    // Remove a few so the slots have holes.
+    for &h in &[hs[5], hs[17]] {
+        w.remove_body(h).unwrap();
+    }
+    hs.retain(|&h| w.bodies().contains(h));
+    (w, hs)
+}
+
+/// Closest hit over every body (ties to the lower slot), and the second-best distance.
+fn brute_ray(
+    w: &World,
+    hs: &[BodyHandle],
+    o: Vec3,
+    d: Vec3,
+    max: Real,
+    mask: u32,
+) -> (Option<(BodyHandle, Real)>, Real) {
+    let mut hits: Vec<(Real, u32, BodyHandle)> = Vec::new();
+    for &h in hs {
+        let obj = w.object(h).unwrap().unwrap();
+        let co = w.collision().get(obj).unwrap();
+        if co.filter.group & mask == 0 {
+            continue;
+        }
+        let pose = w.bodies().pose(h).unwrap();
+        if let Some(hit) = raycast(&co.shape, &pose, o, d, max, true).unwrap() {
+            hits.push((hit.distance, h.index, h));
+        }
+    }
+    hits.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+    let second = hits.get(1).map_or(Real::INFINITY, |x| x.0);
+    (hits.first().map(|x| (x.2, x.0)), second)
+}
+
+fn check_rays(offset: Vec3) {
+    let mut rng = Lcg(7);
+    let (mut w, hs) = scene(offset, &mut rng);
+    // Teleport one body: queries follow the bodies' current poses.
+    w.set_pose(
+        hs[3],
+        Isometry::from_translation(offset + Vec3::new(0.0, 3.0, 0.0)),
+    )
+    .unwrap();
+    let mut origins = Vec::new();
+    let mut dirs = Vec::new();
+    for _ in 0..400 {
+        origins.push(offset + Vec3::new(rng.range(-10.0, 10.0), rng.range(0.2, 8.0), -12.0));
+        dirs.push(Vec3::new(rng.range(-0.3, 0.3), rng.range(-0.4, 0.1), 1.0));
+    }
+    // Rays starting inside a body, and grazing the ground's top face.
+    origins.push(offset + Vec3::new(0.0, 3.0, 0.0));
+    dirs.push(Vec3::X);
+    origins.push(offset + Vec3::new(-30.0, 0.0, 0.0));
+    dirs.push(Vec3::X);
+    for (max, mask) in [(30.0, u32::MAX), (Real::INFINITY, u32::MAX), (30.0, 2)] {
+        let batch = w.raycast_batch(&origins, &dirs, max, mask).unwrap();
+        let mut hits = 0;
+        for (i, got) in batch.iter().enumerate() {
+            let d = dirs[i].normalize();
+            let (want, second) = brute_ray(&w, &hs, origins[i], d, max, mask);
+            match (got, want) {
+                (None, None) => {}
+                (Some(g), Some((b, dist))) => {
+                    hits += 1;
+                    let tol = 1e-4 * (1.0 + offset.length());
+                    assert!(
+                        (g.hit.distance - dist).abs() <= tol,
+                        "ray {i}: {} vs {dist}",
+                        g.hit.distance
+                    );
+                    if second - dist > tol {
+                        assert_eq!(g.body, b, "ray {i}");
+                    }
+                    let p = origins[i] + d * g.hit.distance;
+                    assert!((g.hit.point - p).length() <= 10.0 * tol, "ray {i}: point");
+                    assert!((g.hit.normal.length() - 1.0).abs() < 1e-3);
+                }
+                (g, w) => panic!("ray {i} (max {max}, mask {mask}): {g:?} vs brute force {w:?}"),
+            }
+            let single = w.raycast(origins[i], dirs[i], max, mask).unwrap();
+            assert_eq!(single, *got, "single and batch differ on ray {i}");
+        }
+        // Both hits and misses occur (the mask keeps a quarter of the bodies).
+        let rate = hits as Real / batch.len() as Real;
+        assert!(
+            hits >= 8 && rate < 0.9,
+            "hit rate {rate} (max {max}, mask {mask})"
+        );
+    }
+    let inside = w
+        .raycast(offset + Vec3::new(0.0, 3.0, 0.0), Vec3::X, 5.0, u32::MAX)
+        .unwrap()
+        .unwrap();
+    assert_eq!(inside.body, hs[3]);
+    assert_eq!(inside.hit.distance, 0.0);
+}
+
+#[test]
+fn rays_through_the_world_equal_the_brute_force() {
+    check_rays(Vec3::ZERO);
+}
+
+#[test]
+fn rays_far_from_the_origin_equal_the_brute_force() {
+    check_rays(Vec3::new(1000.0, -500.0, 2000.0));
+}
+
+#[test]
+fn shape_casts_through_the_world_equal_the_brute_force() {
+    let mut rng = Lcg(11);
+    let (w, hs) = scene(Vec3::ZERO, &mut rng);
+    let probe = sphere(0.25);
+    let boxy = cuboid(Vec3::new(0.3, 0.2, 0.1));
+    let mut hits = 0;
+    for k in 0..150 {
+        let shape = if k % 2 == 0 { &probe } else { &boxy };
+        let pose = Isometry::new(
+            Vec3::new(rng.range(-9.0, 9.0), rng.range(0.5, 7.0), -11.0),
+            Quat::from_rotation_z(rng.range(0.0, 3.0)),
+        );
+        let vel = Vec3::new(rng.range(-2.0, 2.0), rng.range(-3.0, 1.0), 20.0);
+        let got = w.shape_cast(shape, &pose, vel, 1.0, u32::MAX).unwrap();
+        let mut best: Option<(Real, BodyHandle)> = None;
+        for &h in &hs {
+            let obj = w.object(h).unwrap().unwrap();
+            let other = &w.collision().get(obj).unwrap().shape;
+            let pb = w.bodies().pose(h).unwrap();
+            if let Some(hit) = shape_cast(shape, &pose, vel, other, &pb, Vec3::ZERO, 1.0).unwrap() {
+                if best.is_none_or(|b| hit.toi < b.0) {
+                    best = Some((hit.toi, h));
+                }
+            }
+        }
+        match (got, best) {
+            (None, None) => {}
+            (Some(g), Some((toi, _))) => {
+                hits += 1;
+                assert!(
+                    (g.hit.toi - toi).abs() < 1e-4,
+                    "cast {k}: {} vs {toi}",
+                    g.hit.toi
+                );
+            }
+            (g, b) => panic!("cast {k}: {g:?} vs brute force {b:?}"),
+        }
+    }
+    assert!((20..140).contains(&hits), "{hits} hits of 150");
+    // Starting in contact with the ground: time of impact 0.
+    let on_ground = Isometry::from_translation(Vec3::new(15.0, 0.25, 15.0));
+    let hit = w
+        .shape_cast(&probe, &on_ground, Vec3::Y, 1.0, u32::MAX)
+        .unwrap()
+        .unwrap();
+    assert_eq!(hit.body, hs[0]);
+    assert!(hit.hit.toi <= 1e-4);
+}
+
+#[test]
+fn queries_reject_bad_input_and_handle_an_empty_world() {
+    let w = world(false);
+    assert!(w
+        .raycast(Vec3::ZERO, Vec3::X, 10.0, u32::MAX)
+        .unwrap()
+        .is_none());
+    assert!(w
+        .shape_cast(&sphere(1.0), &Isometry::IDENTITY, Vec3::X, 1.0, u32::MAX)
+        .unwrap()
+        .is_none());
+    let e = w
+        .raycast(Vec3::ZERO, Vec3::ZERO, 10.0, u32::MAX)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("direction"), "{e}");
+    let e = w
+        .raycast(Vec3::ZERO, Vec3::X, -1.0, u32::MAX)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("max_distance"), "{e}");
+    let e = w
+        .raycast(Vec3::splat(Real::NAN), Vec3::X, 1.0, u32::MAX)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("origin"), "{e}");
+    let e = w
+        .raycast_batch(
+            &[Vec3::ZERO, Vec3::ZERO],
+            &[Vec3::X, Vec3::ZERO],
+            1.0,
+            u32::MAX,
+        )
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("ray 1"), "{e}");
+    let e = w
+        .raycast_batch(&[Vec3::ZERO; 3], &[Vec3::X; 2], 1.0, u32::MAX)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("directions"), "{e}");
+    let e = w
+        .shape_cast(
+            &sphere(1.0),
+            &Isometry::IDENTITY,
+            Vec3::splat(Real::NAN),
+            1.0,
+            u32::MAX,
+        )
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("velocity"), "{e}");
+}
