@@ -99,7 +99,8 @@ from carom._carom import BroadPhase, DynamicTree, overlapping_pairs  # noqa: E40
 
 __all__ += ["BroadPhase", "DynamicTree", "overlapping_pairs"]
 
-# Rigid-body simulation: bodies, the step pipeline, numpy state in bulk.
-from carom._carom import World  # noqa: E402
+# Rigid-body simulation: bodies, joints, the step pipeline, numpy state in bulk, contact
+# events, ray and shape casts through the world, snapshots.
+from carom._carom import World, WorldContacts, WorldRayHit, WorldShapeCastHit  # noqa: E402
 
-__all__ += ["World"]
+__all__ += ["World", "WorldContacts", "WorldRayHit", "WorldShapeCastHit"]

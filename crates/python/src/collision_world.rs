@@ -48,7 +48,7 @@ fn vecs(py: Python<'_>, xs: &[Vec3]) -> Obj {
     crate::convert::vec3s_out(py, xs).into_any().unbind()
 }
 
-fn pairs_out(py: Python<'_>, ps: &[(u64, u64)]) -> Obj {
+pub(crate) fn pairs_out(py: Python<'_>, ps: &[(u64, u64)]) -> Obj {
     Array2::from_shape_fn((ps.len(), 2), |(i, j)| {
         let p = ps[i];
         (if j == 0 { p.0 } else { p.1 }) as i64
@@ -104,6 +104,18 @@ impl PyContacts {
             distance: reals(py, pts.iter().map(|(_, p)| p.distance)),
             depth: reals(py, pts.iter().map(|(_, p)| -p.distance)),
             feature: feature.into_pyarray(py).into_any().unbind(),
+        }
+    }
+}
+
+impl PyContactEvents {
+    /// Events grouped as `[begin, persist, end]` lists of handle pairs (also used by
+    /// `carom.World`, whose pairs are body handles).
+    pub(crate) fn from_groups(py: Python<'_>, by: &[Vec<(u64, u64)>; 3]) -> Self {
+        PyContactEvents {
+            begin: pairs_out(py, &by[0]),
+            persist: pairs_out(py, &by[1]),
+            end: pairs_out(py, &by[2]),
         }
     }
 }
@@ -318,11 +330,7 @@ impl PyCollisionWorld {
             };
             by[k].push((bits(e.a), bits(e.b)));
         }
-        PyContactEvents {
-            begin: pairs_out(py, &by[0]),
-            persist: pairs_out(py, &by[1]),
-            end: pairs_out(py, &by[2]),
-        }
+        PyContactEvents::from_groups(py, &by)
     }
 
     /// The broadphase pairs (overlapping boxes, filters passed) as of the last `step`,

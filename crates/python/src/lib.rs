@@ -23,6 +23,9 @@ mod serialize;
 mod shape;
 mod shapes;
 mod world;
+mod world_joints;
+mod world_queries;
+mod world_snapshot;
 
 use pyo3::prelude::*;
 
@@ -57,5 +60,8 @@ fn _carom(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<dynamic_tree::PyDynamicTree>()?;
     collision_world::register(m)?;
     m.add_class::<world::PyWorld>()?;
+    m.add_class::<world_queries::PyWorldRayHit>()?;
+    m.add_class::<world_queries::PyWorldShapeCastHit>()?;
+    m.add_class::<world_queries::PyWorldContacts>()?;
     Ok(())
 }

@@ -57,6 +57,11 @@ fn same<T: PartialEq>(rebuilt: T, decoded: &T, what: &str) -> Result<()> {
     }
 }
 
+/// Checks a decoded shape (also the shapes of a `carom.World` snapshot).
+pub fn validate_shape(shape: &Shape) -> Result<()> {
+    validate(shape, 0)
+}
+
 /// Checks a decoded shape by rebuilding it through its constructor (hulls: index checks).
 fn validate(shape: &Shape, depth: usize) -> Result<()> {
     if depth > MAX_DEPTH {

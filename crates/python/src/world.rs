@@ -6,22 +6,27 @@
 //! are rejected). Poses are `(N, 7)` arrays `[x, y, z, qx, qy, qz, qw]` as everywhere in
 //! `carom`; bulk getters and setters take and return numpy arrays in one call, in the order
 //! of the given handles (or of `handles()`).
+//!
+//! Joints (`add_joint`, argument parsing in `world_joints`), contact events and points, ray
+//! and shape casts (`world_queries`), and snapshots: `to_bytes()` is a short header holding
+//! the `dt` of `step()` followed by `carom_dynamics::World::to_bytes`; pickling goes through
+//! it (`__reduce__` → `World()` + `__setstate__(bytes)`), so a restored world continues
+//! bit for bit.
 
 use crate::convert::{scalar, vec3, vec3s, vec3s_out};
-use crate::errors::{core, invalid};
+use crate::errors::{core, guard, invalid};
 use crate::pose::{extract_isometry, extract_poses, Pose64};
 use crate::queries::shape_arg;
+use crate::world_joints::{joint_bits, joint_desc, joint_handle, JointOptions};
+use crate::world_queries::{bits, PyWorldContacts, PyWorldRayHit, PyWorldShapeCastHit};
+use crate::world_snapshot::{decode, encode};
 use carom_collision::broadphase::{Filter, Method};
 use carom_collision::math::{check_finite_vec, Isometry, Real};
 use carom_dynamics::{BodyDesc, BodyHandle, BodyType, MassSpec, PipelineParams, World};
 use numpy::ndarray::Array2;
 use numpy::IntoPyArray;
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
-
-fn bits(h: BodyHandle) -> u64 {
-    (u64::from(h.generation) << 32) | u64::from(h.index)
-}
+use pyo3::types::{PyBytes, PyDict, PyTuple};
 
 fn handle(b: u64) -> BodyHandle {
     BodyHandle {
@@ -183,6 +188,11 @@ impl PyWorld {
         fixed_step: Option<f64>,
     ) -> PyResult<u32> {
         let e = scalar("elapsed", elapsed)?;
+        if !(e.is_finite() && e >= 0.0) {
+            return Err(invalid(format!(
+                "invalid elapsed = {elapsed:?}: must be finite and >= 0"
+            )));
+        }
         let f = match fixed_step {
             Some(f) => scalar("fixed_step", f)?,
             None => self.dt,
@@ -304,6 +314,31 @@ impl PyWorld {
         })
     }
 
+    /// Adds a force (N, world frame) for the next step, at the centre of mass or at a world
+    /// `point` (adding its torque); wakes the body.
+    #[pyo3(signature = (handle, force, point = None))]
+    fn add_force(
+        &mut self,
+        handle: u64,
+        force: &Bound<'_, PyAny>,
+        point: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<()> {
+        let f = vec3(force, "force")?;
+        let p = point.map(|p| vec3(p, "point")).transpose()?;
+        let bodies = self.world.bodies_mut();
+        let h = self::handle(handle);
+        core(|| match p {
+            Some(p) => bodies.add_force_at_point(h, f, p),
+            None => bodies.add_force(h, f),
+        })
+    }
+
+    /// Adds a torque (N·m, world frame) for the next step; wakes the body.
+    fn add_torque(&mut self, handle: u64, torque: &Bound<'_, PyAny>) -> PyResult<()> {
+        let t = vec3(torque, "torque")?;
+        core(|| self.world.bodies_mut().add_torque(self::handle(handle), t))
+    }
+
     /// Whether body `handle` is asleep.
     fn is_sleeping(&self, handle: u64) -> PyResult<bool> {
         core(|| self.world.bodies().is_sleeping(self::handle(handle)))
@@ -332,6 +367,196 @@ impl PyWorld {
         d.set_item("manifolds", r.manifolds)?;
         d.set_item("points", r.contact_points)?;
         Ok(d)
+    }
+
+    /// Adds a joint between bodies `body_a` and `body_b` (at least one dynamic); returns its
+    /// handle. `kind`: "ball" (point to point), "hinge" (rotation about the frames' Z axis;
+    /// `limits=(low, high)` rad, `motor=(speed, max_torque)`), "cone_twist" (`swing1` about
+    /// frame Z, `swing2` about frame Y, `twist` about frame X, rad, all required), "slider"
+    /// (translation along frame A's X; `limits` m, `motor=(speed, max_force)`), "fixed", or
+    /// "6dof" (`linear` and `angular`: three axes each, x, y, z of frame A, each "locked",
+    /// "free", `(low, high)` or a dict with `limits`, `motor=(speed, max_force)`,
+    /// `spring=(hertz, damping_ratio, rest)`). `frame_a`/`frame_b` are the joint frames in
+    /// each body's frame (poses, default identity). The joint breaks once one of its
+    /// impulses in a step exceeds `break_impulse` (N·s); `disable_collisions` turns off
+    /// contacts between the two bodies. Options that do not apply to `kind` raise.
+    #[pyo3(signature = (
+        kind, body_a, body_b, frame_a = None, frame_b = None, limits = None, motor = None,
+        swing1 = None, swing2 = None, twist = None, linear = None, angular = None,
+        break_impulse = f64::INFINITY, disable_collisions = true
+    ))]
+    #[allow(clippy::too_many_arguments)]
+    fn add_joint(
+        &mut self,
+        kind: &str,
+        body_a: u64,
+        body_b: u64,
+        frame_a: Option<&Bound<'_, PyAny>>,
+        frame_b: Option<&Bound<'_, PyAny>>,
+        limits: Option<(f64, f64)>,
+        motor: Option<(f64, f64)>,
+        swing1: Option<f64>,
+        swing2: Option<f64>,
+        twist: Option<f64>,
+        linear: Option<&Bound<'_, PyAny>>,
+        angular: Option<&Bound<'_, PyAny>>,
+        break_impulse: f64,
+        disable_collisions: bool,
+    ) -> PyResult<u64> {
+        let opts = JointOptions {
+            frame_a,
+            frame_b,
+            limits,
+            motor,
+            swing1,
+            swing2,
+            twist,
+            linear,
+            angular,
+            break_impulse,
+            disable_collisions,
+        };
+        let desc = joint_desc(kind, handle(body_a), handle(body_b), &opts)?;
+        let h = core(|| self.world.create_joint(&desc))?;
+        Ok(joint_bits(h))
+    }
+
+    /// Removes joint `joint` (wakes its bodies).
+    fn remove_joint(&mut self, joint: u64) -> PyResult<()> {
+        core(|| self.world.remove_joint(joint_handle(joint)))
+    }
+
+    /// The live joints' handles, in slot order (joints attached to a removed body are
+    /// removed with it).
+    fn joints(&self) -> Vec<u64> {
+        self.world
+            .joints()
+            .iter()
+            .map(|(h, _)| joint_bits(h))
+            .collect()
+    }
+
+    /// Whether `joint` is a live joint.
+    fn has_joint(&self, joint: u64) -> bool {
+        self.world.joints().get(joint_handle(joint)).is_ok()
+    }
+
+    /// Whether `joint` has broken (its impulse exceeded `break_impulse`); a broken joint no
+    /// longer acts.
+    fn is_joint_broken(&self, joint: u64) -> PyResult<bool> {
+        core(|| {
+            self.world
+                .joints()
+                .get(joint_handle(joint))
+                .map(|j| j.broken)
+        })
+    }
+
+    /// The two bodies `(body_a, body_b)` of `joint`.
+    fn joint_bodies(&self, joint: u64) -> PyResult<(u64, u64)> {
+        let j = core(|| self.world.joints().get(joint_handle(joint)))?;
+        Ok((bits(j.desc.body_a), bits(j.desc.body_b)))
+    }
+
+    /// Contact events of the last step with body handles: `begin`, `persist` and `end`, each
+    /// an `(E, 2)` int64 array of `(body_a, body_b)` pairs, in pair order.
+    fn contact_events(&self, py: Python<'_>) -> crate::collision_world::PyContactEvents {
+        crate::world_queries::contact_events(py, &self.world)
+    }
+
+    /// The contact points of the last step with the solver's impulses (see `WorldContacts`).
+    fn contacts(&self, py: Python<'_>) -> PyWorldContacts {
+        crate::world_queries::contacts(py, &self.world)
+    }
+
+    /// Casts rays against every body (closest hit, current poses). One `(3,)` origin and
+    /// direction: a `WorldRayHit` or `None` on a miss. `(N, 3)` origins and directions (or
+    /// one direction for all): a `WorldRayHit` of arrays (GIL released). Only bodies whose
+    /// `group` meets `mask` are hit; a ray starting inside a body hits it at distance 0.
+    #[pyo3(signature = (origins, directions, max_distance = f64::INFINITY, mask = 0xFFFF_FFFF))]
+    fn raycast(
+        &self,
+        py: Python<'_>,
+        origins: &Bound<'_, PyAny>,
+        directions: &Bound<'_, PyAny>,
+        max_distance: f64,
+        mask: u32,
+    ) -> PyResult<Option<PyWorldRayHit>> {
+        let md = scalar("max_distance", max_distance)?;
+        let (o, so) = vec3s(origins, "origins", true)?;
+        let (d, sd) = vec3s(directions, "directions", true)?;
+        if so && sd {
+            let h = core(|| self.world.raycast(o[0], d[0], md, mask))?;
+            return Ok(h.map(|h| PyWorldRayHit::one(py, &h)));
+        }
+        let w = &self.world;
+        let hs = py.detach(|| core(|| w.raycast_batch(&o, &d, md, mask)))?;
+        Ok(Some(PyWorldRayHit::many(py, &hs)))
+    }
+
+    /// Sweeps `shape` from `pose` with `velocity` (per unit time, no rotation) over times
+    /// `[0, max_time]` against every body whose `group` meets `mask`: the first hit as a
+    /// `WorldShapeCastHit`, or `None`. A body overlapping at the start is hit at time 0.
+    #[pyo3(signature = (shape, pose, velocity, max_time = 1.0, mask = 0xFFFF_FFFF))]
+    fn shape_cast(
+        &self,
+        py: Python<'_>,
+        shape: &Bound<'_, PyAny>,
+        pose: &Bound<'_, PyAny>,
+        velocity: &Bound<'_, PyAny>,
+        max_time: f64,
+        mask: u32,
+    ) -> PyResult<Option<PyWorldShapeCastHit>> {
+        let s = shape_arg(shape, "shape")?;
+        let p = extract_isometry(Some(pose), "pose")?;
+        let v = vec3(velocity, "velocity")?;
+        let t = scalar("max_time", max_time)?;
+        let w = &self.world;
+        let h = py.detach(|| core(|| w.shape_cast(&s, &p, v, t, mask)))?;
+        Ok(h.map(|h| PyWorldShapeCastHit::new(py, &h)))
+    }
+
+    /// The whole world as bytes (bodies, joints, contacts with their warm-starting
+    /// impulses, sleep state, the accumulator of `step_simulation`, `dt`):
+    /// `World.from_bytes(data)` continues bit for bit as if never stopped.
+    fn to_bytes<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyBytes>> {
+        let out = encode(&self.world, self.dt)?;
+        Ok(PyBytes::new(py, &out))
+    }
+
+    /// Restores a world from `to_bytes()`; corrupt or truncated bytes raise `CaromError`.
+    #[staticmethod]
+    fn from_bytes(data: &[u8]) -> PyResult<PyWorld> {
+        let (world, dt) = guard(|| decode(data))?;
+        Ok(PyWorld { world, dt })
+    }
+
+    /// Pickle support: the state is `to_bytes()`.
+    fn __getstate__<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyBytes>> {
+        self.to_bytes(py)
+    }
+
+    /// Pickle support: replaces this world with the one in `state` (bytes of `to_bytes()`).
+    fn __setstate__(&mut self, state: &[u8]) -> PyResult<()> {
+        let (world, dt) = guard(|| decode(state))?;
+        self.world = world;
+        self.dt = dt;
+        Ok(())
+    }
+
+    /// Pickle support: `(World, (), state)`.
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyTuple>> {
+        let py = slf.py();
+        let state = slf.borrow().to_bytes(py)?;
+        let cls = slf.get_type();
+        PyTuple::new(
+            py,
+            [
+                cls.into_any(),
+                PyTuple::empty(py).into_any(),
+                state.into_any(),
+            ],
+        )
     }
 
     /// The step of `step()`, seconds.
