@@ -275,3 +275,31 @@ fn meshes_round_trip_through_serde() {
         mesh.raycast(o, -Vec3::Y, 10.0)
     );
 }
+
+#[test]
+fn batch_rays_equal_serial_rays_on_any_thread_count() {
+    // The batch path splits the rays over rayon's workers (no shared mutable state): the
+    // results are those of the serial loop, bit for bit, whatever the thread count.
+    let (v, t) = grid_mesh(40, 20.0, Vec3::new(-10.0, 0.0, -10.0));
+    let mesh = TriMesh::new(v, t).unwrap();
+    let mut rng = Rng(9);
+    let origins: Vec<Vec3> = (0..3000)
+        .map(|_| rng.vec(-12.0, 12.0) + Vec3::Y * 15.0)
+        .collect();
+    let dirs: Vec<Vec3> = (0..3000).map(|_| rng.vec(-0.5, 0.5) - Vec3::Y).collect();
+    let serial: Vec<_> = origins
+        .iter()
+        .zip(&dirs)
+        .map(|(&o, &d)| mesh.raycast(o, d, 100.0))
+        .collect();
+    let hits = serial.iter().filter(|h| h.is_some()).count();
+    assert!((900..2900).contains(&hits), "{hits} hits");
+    for threads in [1, 2, 3, 8] {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        let batch = pool.install(|| mesh.raycast_batch(&origins, &dirs, 100.0).unwrap());
+        assert_eq!(batch, serial, "{threads} threads");
+    }
+}
