@@ -5,7 +5,7 @@
 mod midphase_common;
 
 use carom_collision::math::{Aabb, Isometry, Quat, Real, Vec3};
-use carom_collision::midphase::{brute_force, triangle_aabbs, Bvh, BvhLayout, MeshView};
+use carom_collision::midphase::{brute_force, triangle_aabbs, Bvh, BvhLayout, MeshView, WideNode};
 use midphase_common::{grid_mesh, soup_mesh, Rng};
 
 struct Mesh {
@@ -266,7 +266,11 @@ fn quantized_nodes_are_small() {
     let mesh = Mesh::new(grid_mesh(64, 10.0, Vec3::ZERO));
     let per_tri = mesh.q.memory_bytes() as f64 / mesh.t.len() as f64;
     assert!(per_tri <= 32.0, "{per_tri} bytes per triangle");
-    assert!(mesh.q.memory_bytes() < mesh.u.memory_bytes());
+    // The binary quantised nodes are smaller than the unquantised ones; the 4-wide nodes
+    // kept beside them for closest-hit rays are an extra 64 bytes each.
+    let wide = mesh.q.num_wide_nodes() * std::mem::size_of::<WideNode>();
+    assert!(wide > 0 && mesh.u.num_wide_nodes() == 0);
+    assert!(mesh.q.memory_bytes() - wide < mesh.u.memory_bytes());
 }
 
 #[test]
@@ -300,5 +304,67 @@ fn rays_along_edges_and_faces_match_brute_force() {
                 }
             }
         }
+    }
+}
+
+#[test]
+fn wide_walk_on_tiny_stacked_and_identical_meshes() {
+    // The quantised layout's closest-hit walk runs on 4-wide nodes: check it against brute
+    // force where the collapse is unusual: one leaf (no wide node), a few triangles, a deep
+    // stack of parallel triangles (many deferred children, ties only across layers) and
+    // hundreds of identical triangles (every hit ties; the smallest index must win).
+    let tri = [
+        Vec3::ZERO,
+        Vec3::new(1.0, 0.0, 0.0),
+        Vec3::new(0.0, 0.0, 1.0),
+    ];
+    let mut cases: Vec<(Vec<Vec3>, Vec<[u32; 3]>)> = Vec::new();
+    for n in [1usize, 2, 3, 5, 9] {
+        let mut v = Vec::new();
+        let mut t = Vec::new();
+        for i in 0..n {
+            let off = Vec3::new(i as Real * 0.7, (i % 3) as Real * 0.1, 0.0);
+            let b = v.len() as u32;
+            v.extend(tri.map(|p| p + off));
+            t.push([b, b + 1, b + 2]);
+        }
+        cases.push((v, t));
+    }
+    let layers: Vec<Vec3> = (0..1500)
+        .flat_map(|i| tri.map(|p| p * 4.0 + Vec3::new(0.0, i as Real * 0.01, 0.0)))
+        .collect();
+    cases.push((
+        layers,
+        (0..1500u32)
+            .map(|i| [3 * i, 3 * i + 1, 3 * i + 2])
+            .collect(),
+    ));
+    cases.push((tri.to_vec(), vec![[0, 1, 2]; 700]));
+    let mut rng = Rng(77);
+    for (v, t) in cases {
+        let mesh = Mesh::new((v, t));
+        let b = mesh.bounds();
+        let mut hits = 0;
+        for k in 0..200 {
+            let target = b.min + b.extents() * Vec3::new(rng.f(), rng.f(), rng.f());
+            let origin = if k % 2 == 0 {
+                target + Vec3::new(0.0, 50.0, 0.0)
+            } else {
+                b.center() + rng.unit() * (b.extents().length() + 1.0)
+            };
+            let dir = target - origin;
+            let want = brute_force::ray_closest(&mesh.views()[0], origin, dir, 1e30);
+            hits += want.is_some() as usize;
+            for view in mesh.views() {
+                let got = view.ray_closest(origin, dir, 1e30);
+                assert_eq!(
+                    got.map(|h| key(&h)),
+                    want.map(|h| key(&h)),
+                    "{} tris",
+                    mesh.t.len()
+                );
+            }
+        }
+        assert!(hits > 20, "{hits} hits on {} triangles", mesh.t.len());
     }
 }

@@ -275,3 +275,87 @@ fn meshes_round_trip_through_serde() {
         mesh.raycast(o, -Vec3::Y, 10.0)
     );
 }
+
+#[test]
+fn batch_rays_equal_serial_rays_on_any_thread_count() {
+    // The batch path splits the rays over rayon's workers (no shared mutable state): the
+    // results are those of the serial loop, bit for bit, whatever the thread count.
+    let (v, t) = grid_mesh(40, 20.0, Vec3::new(-10.0, 0.0, -10.0));
+    let mesh = TriMesh::new(v, t).unwrap();
+    let mut rng = Rng(9);
+    let origins: Vec<Vec3> = (0..3000)
+        .map(|_| rng.vec(-12.0, 12.0) + Vec3::Y * 15.0)
+        .collect();
+    let dirs: Vec<Vec3> = (0..3000).map(|_| rng.vec(-0.5, 0.5) - Vec3::Y).collect();
+    let serial: Vec<_> = origins
+        .iter()
+        .zip(&dirs)
+        .map(|(&o, &d)| mesh.raycast(o, d, 100.0))
+        .collect();
+    let hits = serial.iter().filter(|h| h.is_some()).count();
+    assert!((900..2900).contains(&hits), "{hits} hits");
+    for threads in [1, 2, 3, 8] {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        let batch = pool.install(|| mesh.raycast_batch(&origins, &dirs, 100.0).unwrap());
+        assert_eq!(batch, serial, "{threads} threads");
+    }
+}
+
+#[test]
+fn closed_mesh_mass_properties_match_the_analytic_box() {
+    // A box with half extents h as a closed, outward-oriented mesh, near and far from the
+    // origin: mass 8·hx·hy·hz·ρ, centre at the offset, inertia m/3·(hy² + hz², …).
+    let h = Vec3::new(1.0, 0.5, 2.0);
+    let density = 3.0;
+    for offset in [Vec3::new(0.5, -1.0, 2.0), Vec3::new(1.0e3, -2.0e3, 5.0e2)] {
+        let v: Vec<Vec3> = (0..8)
+            .map(|i| {
+                let s = |bit: u32| if i & bit != 0 { 1.0 } else { -1.0 };
+                offset + Vec3::new(s(4), s(2), s(1)) * h
+            })
+            .collect();
+        let t = vec![
+            [0, 1, 3],
+            [0, 3, 2],
+            [4, 6, 7],
+            [4, 7, 5],
+            [0, 4, 5],
+            [0, 5, 1],
+            [2, 3, 7],
+            [2, 7, 6],
+            [0, 2, 6],
+            [0, 6, 4],
+            [1, 5, 7],
+            [1, 7, 3],
+        ];
+        let mesh = TriMesh::new(v, t).unwrap();
+        let mp = mesh.mass_properties(density);
+        let mass = 8.0 * h.x * h.y * h.z * density;
+        let rel = if offset.length() > 100.0 { 2e-3 } else { 1e-5 };
+        assert!(
+            (mp.mass - mass).abs() <= mass * rel,
+            "{} vs {mass}",
+            mp.mass
+        );
+        assert!((mp.center_of_mass - offset).length() <= offset.length() * rel + 1e-5);
+        let want = Vec3::new(
+            h.y * h.y + h.z * h.z,
+            h.x * h.x + h.z * h.z,
+            h.x * h.x + h.y * h.y,
+        ) * (mass / 3.0);
+        let got = Vec3::new(
+            mp.inertia.x_axis.x,
+            mp.inertia.y_axis.y,
+            mp.inertia.z_axis.z,
+        );
+        let tol = if offset.length() > 100.0 { 0.05 } else { 1e-4 };
+        assert!(
+            (got - want).abs().max_element() <= want.max_element() * tol,
+            "{got} vs {want}"
+        );
+        assert!((mesh.volume() - mass / density).abs() <= mass / density * rel);
+    }
+}

@@ -4,18 +4,18 @@
 //! Each constructor is the one place its core constructor is called.
 
 use crate::convert::{
-    array_values, float_array, index_triples, indices_out, scalar, shape_str, to_real, triples_out,
-    vec3_out, vec3s, vec3s_out,
+    array_values, float_array, indices_out, scalar, shape_str, to_real, triples_out, vec3_out,
+    vec3s, vec3s_out,
 };
 use crate::errors::{carom_err, core, invalid};
+/// `carom.TriMesh` lives with the other mesh bindings in `mesh.rs`.
+pub use crate::mesh::PyTriMesh;
 use crate::pose::{extract_isometry, Pose64, PyPose};
 use crate::serialize::hull_problem;
 use crate::shape::{scale_factors, PyShape};
 use crate::shapes::{init, shape_of, wrap_shape, wrong_kind};
 use carom_collision::math::Isometry;
-use carom_collision::shape::{
-    Compound, ConvexHull, HeightField, Scaled, Shape, TriMesh, TriMeshOptions,
-};
+use carom_collision::shape::{Compound, ConvexHull, HeightField, Scaled, Shape};
 use carom_collision::CaromError;
 use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray1, PyArray2};
@@ -82,122 +82,6 @@ impl PyConvexHull {
         match shape_of(slf) {
             Shape::ConvexHull(h) => Ok(triples_out(slf.py(), h.triangles())),
             _ => Err(wrong_kind("ConvexHull")),
-        }
-    }
-}
-
-/// A triangle mesh: `vertices` `(V, 3)` (finite) and `indices` `(T, 3)` integers in
-/// `[0, V)`, counter-clockwise triangles. Volume and mass are those of the enclosed solid for
-/// a closed, outward-oriented mesh. Not convex: no support map.
-#[pyclass(name = "TriMesh", module = "carom", extends = PyShape, frozen)]
-pub struct PyTriMesh;
-
-#[pymethods]
-impl PyTriMesh {
-    #[new]
-    fn new(
-        vertices: &Bound<'_, PyAny>,
-        indices: &Bound<'_, PyAny>,
-    ) -> PyResult<PyClassInitializer<Self>> {
-        let (verts, _) = vec3s(vertices, "vertices", false)?;
-        let tris = index_triples(indices, "indices")?;
-        Ok(init(core(|| TriMesh::new(verts, tris))?.into(), PyTriMesh))
-    }
-
-    /// The vertices, `(V, 3)`.
-    #[getter]
-    fn vertices<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyArray2<f64>>> {
-        match shape_of(slf) {
-            Shape::TriMesh(m) => Ok(vec3s_out(slf.py(), m.vertices())),
-            _ => Err(wrong_kind("TriMesh")),
-        }
-    }
-
-    /// The triangles as vertex indices, `(T, 3)` int64.
-    #[getter]
-    fn indices<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyArray2<i64>>> {
-        match shape_of(slf) {
-            Shape::TriMesh(m) => Ok(triples_out(slf.py(), m.indices())),
-            _ => Err(wrong_kind("TriMesh")),
-        }
-    }
-
-    /// Loads a mesh from a `.obj` or `.stl` file (by extension, case-insensitive; OBJ
-    /// polygons are triangulated, STL duplicate vertices merged). Unreadable or malformed
-    /// files raise `CaromError`.
-    #[staticmethod]
-    fn load(py: Python<'_>, path: std::path::PathBuf) -> PyResult<Bound<'_, PyAny>> {
-        let mesh = py.detach(move || core(|| TriMesh::load(&path)))?;
-        wrap_shape(py, Arc::new(mesh.into()))
-    }
-
-    /// A mesh from the bytes of an OBJ file (default options).
-    #[staticmethod]
-    fn from_obj_bytes<'py>(py: Python<'py>, data: &[u8]) -> PyResult<Bound<'py, PyAny>> {
-        let mesh = core(|| TriMesh::from_obj_bytes(data, TriMeshOptions::default()))?;
-        wrap_shape(py, Arc::new(mesh.into()))
-    }
-
-    /// A mesh from the bytes of an STL file, ASCII or binary (default options).
-    #[staticmethod]
-    fn from_stl_bytes<'py>(py: Python<'py>, data: &[u8]) -> PyResult<Bound<'py, PyAny>> {
-        let mesh = core(|| TriMesh::from_stl_bytes(data, TriMeshOptions::default()))?;
-        wrap_shape(py, Arc::new(mesh.into()))
-    }
-
-    /// Closest hits of rays in the mesh's own frame: `origins` and `directions` `(N, 3)`
-    /// (finite; directions non-zero, normalised here), up to `max_distance` (>= 0). Returns
-    /// a `MeshRayHits` (`hit`, `distance`, `point`, `normal`, `triangle`, arrays of length
-    /// N). Uses the BVH, releases the GIL and runs in parallel.
-    #[pyo3(signature = (origins, directions, max_distance = f64::INFINITY))]
-    fn raycast(
-        slf: &Bound<'_, Self>,
-        origins: &Bound<'_, PyAny>,
-        directions: &Bound<'_, PyAny>,
-        max_distance: f64,
-    ) -> PyResult<crate::mesh::PyMeshRayHits> {
-        let Shape::TriMesh(m) = shape_of(slf) else {
-            return Err(wrong_kind("TriMesh"));
-        };
-        let md = scalar("max_distance", max_distance)?;
-        crate::mesh::raycast(slf.py(), m, origins, directions, md)
-    }
-
-    /// Closest points of the mesh (its surface, in its own frame) to `points` `(N, 3)`
-    /// within `max_distance`: `(points (N, 3), distances (N,), triangles (N,) int64)`, NaN
-    /// and -1 where no triangle is within `max_distance`. Releases the GIL.
-    #[pyo3(signature = (points, max_distance = f64::INFINITY))]
-    fn closest_points<'py>(
-        slf: &Bound<'py, Self>,
-        points: &Bound<'py, PyAny>,
-        max_distance: f64,
-    ) -> PyResult<Bound<'py, PyTuple>> {
-        let Shape::TriMesh(m) = shape_of(slf) else {
-            return Err(wrong_kind("TriMesh"));
-        };
-        let md = scalar("max_distance", max_distance)?;
-        crate::mesh::closest_points(slf.py(), m, points, md)
-    }
-
-    /// Indices (ascending int64) of the triangles whose bounding boxes overlap the box
-    /// `[aabb_min, aabb_max]` (mesh frame).
-    fn overlapping_triangles<'py>(
-        slf: &Bound<'py, Self>,
-        aabb_min: &Bound<'py, PyAny>,
-        aabb_max: &Bound<'py, PyAny>,
-    ) -> PyResult<Bound<'py, PyArray1<i64>>> {
-        let Shape::TriMesh(m) = shape_of(slf) else {
-            return Err(wrong_kind("TriMesh"));
-        };
-        crate::mesh::overlapping(slf.py(), aabb_min, aabb_max, |b| m.overlapping_triangles(b))
-    }
-
-    /// Number of triangles.
-    #[getter]
-    fn num_triangles(slf: &Bound<'_, Self>) -> PyResult<usize> {
-        match shape_of(slf) {
-            Shape::TriMesh(m) => Ok(m.num_triangles()),
-            _ => Err(wrong_kind("TriMesh")),
         }
     }
 }
@@ -345,6 +229,35 @@ fn child(i: usize, item: &Bound<'_, PyAny>) -> PyResult<(Isometry, Arc<Shape>)> 
     Ok((pose, shape.get().inner.clone()))
 }
 
+fn compound_of<'a>(slf: &'a Bound<'_, PyCompound>) -> PyResult<&'a Compound> {
+    match shape_of(slf) {
+        Shape::Compound(c) => Ok(c),
+        _ => Err(wrong_kind("Compound")),
+    }
+}
+
+/// A checked child index: negative or too large raises `CaromError` naming it.
+fn child_index(slf: &Bound<'_, PyCompound>, index: i64) -> PyResult<u32> {
+    let n = compound_of(slf)?.children().len();
+    match u32::try_from(index) {
+        Ok(i) if (i as usize) < n => Ok(i),
+        _ => Err(invalid(format!(
+            "invalid index = {index}: must be in [0, {n}) for a compound of {n} children"
+        ))),
+    }
+}
+
+/// Copy-on-write edit: a new `Compound` from a copy of this one changed by `edit`; on an
+/// error nothing is created and this one is untouched.
+fn edited<'py>(
+    slf: &Bound<'py, PyCompound>,
+    edit: impl FnOnce(&mut Compound) -> carom_collision::Result<()>,
+) -> PyResult<Bound<'py, PyAny>> {
+    let mut c = compound_of(slf)?.clone();
+    core(|| edit(&mut c))?;
+    wrap_shape(slf.py(), Arc::new(c.into()))
+}
+
 #[pymethods]
 impl PyCompound {
     #[new]
@@ -394,6 +307,55 @@ impl PyCompound {
             i64::from(if j == 0 { pairs[i].0 } else { pairs[i].1 })
         })
         .into_pyarray(slf.py()))
+    }
+
+    /// Number of children.
+    #[getter]
+    fn num_children(slf: &Bound<'_, Self>) -> PyResult<usize> {
+        Ok(compound_of(slf)?.children().len())
+    }
+
+    /// A new compound with `shape` added at `pose` (a `Pose`, a `(7,)` array or `None` for
+    /// the identity) as the last child, index `num_children`. Shapes are immutable: this
+    /// compound, and any world or compound already holding it, is unchanged (the children
+    /// list is copied, O(children); child geometry is shared, not copied). Bad input raises
+    /// (`CaromError` for a bad pose or a plane, `TypeError` for a non-shape).
+    #[pyo3(signature = (shape, pose = None))]
+    fn with_child<'py>(
+        slf: &Bound<'py, Self>,
+        shape: &Bound<'py, PyAny>,
+        pose: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let shape = shape.cast::<PyShape>().map_err(|_| {
+            PyTypeError::new_err(format!(
+                "shape must be a carom.Shape, got {}",
+                type_name(shape)
+            ))
+        })?;
+        let pose = extract_isometry(pose, "pose")?;
+        let inner = shape.get().inner.clone();
+        edited(slf, |c| c.add_child(pose, inner).map(|_| ()))
+    }
+
+    /// A new compound without child `index` (0 <= index < num_children); as in the Rust
+    /// `Compound::remove_child`, the last child takes its index. The only child cannot be
+    /// removed. This compound is unchanged (see `with_child`).
+    fn without_child<'py>(slf: &Bound<'py, Self>, index: i64) -> PyResult<Bound<'py, PyAny>> {
+        let i = child_index(slf, index)?;
+        edited(slf, |c| c.remove_child(i).map(|_| ()))
+    }
+
+    /// A new compound with child `index` moved to `pose` (compound frame); its tree leaf is
+    /// moved, the other children keep their indices. This compound is unchanged (see
+    /// `with_child`).
+    fn with_child_pose<'py>(
+        slf: &Bound<'py, Self>,
+        index: i64,
+        pose: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let i = child_index(slf, index)?;
+        let pose = extract_isometry(Some(pose), "pose")?;
+        edited(slf, |c| c.set_child_pose(i, pose))
     }
 
     /// The children as a list of `(shape, Pose)` pairs (poses at the core's precision,

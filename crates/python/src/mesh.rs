@@ -1,16 +1,25 @@
-//! Triangle-mesh queries in the mesh's own frame (`TriMesh.raycast`, `closest_points`,
-//! `overlapping_triangles`, and the same on heightfields and compounds), thin wrappers of the core's BVH queries
-//! (`carom_collision::shape::TriMesh`); batches release the GIL and run in parallel.
+//! `carom.TriMesh` and the triangle-mesh queries in the mesh's own frame (`raycast`,
+//! `raycast_any`, `raycast_all`, `closest_points`, `overlapping_triangles`,
+//! `overlapping_triangle_pairs`, and the same helpers for heightfields and compounds), thin
+//! wrappers of the core's BVH queries (`carom_collision::shape::TriMesh`); batches release
+//! the GIL and run in parallel.
 
 use crate::batch;
-use crate::convert::{indices_out, require_finite, vec3, vec3s, vec3s_out};
-use crate::errors::{carom_err, guard, invalid};
+use crate::convert::{
+    index_triples, indices_out, require_finite, scalar, triples_out, vec3, vec3s, vec3s_out,
+};
+use crate::errors::{carom_err, core, guard, invalid};
+use crate::pose::extract_isometry;
+use crate::shape::PyShape;
+use crate::shapes::{init, shape_of, wrap_shape, wrong_kind};
 use carom_collision::math::{vec3_to_f64, Aabb, Real, Vec3};
 use carom_collision::midphase::MeshRayHit;
-use carom_collision::shape::{HeightField, TriMesh};
-use numpy::{PyArray1, PyArray2};
+use carom_collision::shape::{HeightField, Shape, TriMesh, TriMeshOptions, NO_NEIGHBOR};
+use numpy::ndarray::Array2;
+use numpy::{IntoPyArray, PyArray1, PyArray2};
 use pyo3::prelude::*;
 use pyo3::types::PyTuple;
+use std::sync::Arc;
 
 /// Closest ray hits on a mesh, one row per ray: `hit` `(N,)` bool, `distance` `(N,)` along
 /// the unit direction, `point` `(N, 3)`, `normal` `(N, 3)` (the triangle's counter-clockwise
@@ -38,22 +47,35 @@ fn rays(
 ) -> PyResult<(Vec<Vec3>, Vec<Vec3>)> {
     let (o, _) = vec3s(origins, "origins", true)?;
     let (d, _) = vec3s(directions, "directions", true)?;
+    rays_checked(o, d, ("origins", "directions"))
+}
+
+/// Checks rays (same count, finite, non-zero directions) and normalises the directions;
+/// errors name the arguments `names`.
+fn rays_checked(
+    o: Vec<Vec3>,
+    d: Vec<Vec3>,
+    names: (&str, &str),
+) -> PyResult<(Vec<Vec3>, Vec<Vec3>)> {
     if o.len() != d.len() {
         return Err(invalid(format!(
-            "origins and directions must have the same length, got {} and {}",
+            "{} and {} must have the same length, got {} and {}",
+            names.0,
+            names.1,
             o.len(),
             d.len()
         )));
     }
-    require_finite("origins", &o)?;
-    require_finite("directions", &d)?;
+    require_finite(names.0, &o)?;
+    require_finite(names.1, &d)?;
     let mut unit = Vec::with_capacity(d.len());
     for (i, v) in d.iter().enumerate() {
         match v.try_normalize() {
             Some(u) => unit.push(u),
             None => {
                 return Err(invalid(format!(
-                    "invalid directions[{i}] = {:?}: must be non-zero",
+                    "invalid {}[{i}] = {:?}: must be non-zero",
+                    names.1,
                     vec3_to_f64(*v)
                 )))
             }
@@ -195,4 +217,242 @@ pub fn overlapping<'py>(
     let aabb = aabb_arg(aabb_min, aabb_max)?;
     let items = guard(|| Ok(query(&aabb)))?;
     Ok(indices_out(py, &items))
+}
+
+fn mesh_of<'a>(slf: &'a Bound<'_, PyTriMesh>) -> PyResult<&'a TriMesh> {
+    match shape_of(slf) {
+        Shape::TriMesh(m) => Ok(m),
+        _ => Err(wrong_kind("TriMesh")),
+    }
+}
+
+/// A triangle mesh: `vertices` `(V, 3)` (finite) and `indices` `(T, 3)` integers in
+/// `[0, V)`, counter-clockwise triangles. With `weld_tolerance` (finite, >= 0), vertices
+/// closer than it are merged first (0 merges exact duplicates), so split meshes get their
+/// edge adjacency. Volume and mass are those of the enclosed solid for a closed,
+/// outward-oriented mesh. Not convex: no support map. Degenerate triangles are kept and
+/// never give NaN. Out-of-range indices, non-finite vertices and empty meshes raise
+/// `CaromError`.
+#[pyclass(name = "TriMesh", module = "carom", extends = PyShape, frozen)]
+pub struct PyTriMesh;
+
+#[pymethods]
+impl PyTriMesh {
+    #[new]
+    #[pyo3(signature = (vertices, indices, weld_tolerance = None))]
+    fn new(
+        vertices: &Bound<'_, PyAny>,
+        indices: &Bound<'_, PyAny>,
+        weld_tolerance: Option<f64>,
+    ) -> PyResult<PyClassInitializer<Self>> {
+        let (verts, _) = vec3s(vertices, "vertices", false)?;
+        let tris = index_triples(indices, "indices")?;
+        let options = TriMeshOptions {
+            weld_tolerance: weld_tolerance
+                .map(|t| scalar("weld_tolerance", t))
+                .transpose()?,
+            ..Default::default()
+        };
+        let mesh = core(|| TriMesh::with_options(verts, tris, options))?;
+        Ok(init(mesh.into(), PyTriMesh))
+    }
+
+    /// The vertices, `(V, 3)`.
+    #[getter]
+    fn vertices<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        match shape_of(slf) {
+            Shape::TriMesh(m) => Ok(vec3s_out(slf.py(), m.vertices())),
+            _ => Err(wrong_kind("TriMesh")),
+        }
+    }
+
+    /// The triangles as vertex indices, `(T, 3)` int64.
+    #[getter]
+    fn indices<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyArray2<i64>>> {
+        match shape_of(slf) {
+            Shape::TriMesh(m) => Ok(triples_out(slf.py(), m.indices())),
+            _ => Err(wrong_kind("TriMesh")),
+        }
+    }
+
+    /// Loads a mesh from a `.obj` or `.stl` file (by extension, case-insensitive; OBJ
+    /// polygons are triangulated, STL duplicate vertices merged). Unreadable or malformed
+    /// files raise `CaromError`.
+    #[staticmethod]
+    fn load(py: Python<'_>, path: std::path::PathBuf) -> PyResult<Bound<'_, PyAny>> {
+        let mesh = py.detach(move || core(|| TriMesh::load(&path)))?;
+        wrap_shape(py, Arc::new(mesh.into()))
+    }
+
+    /// A mesh from the bytes of an OBJ file (default options).
+    #[staticmethod]
+    fn from_obj_bytes<'py>(py: Python<'py>, data: &[u8]) -> PyResult<Bound<'py, PyAny>> {
+        let mesh = core(|| TriMesh::from_obj_bytes(data, TriMeshOptions::default()))?;
+        wrap_shape(py, Arc::new(mesh.into()))
+    }
+
+    /// A mesh from the bytes of an STL file, ASCII or binary (default options).
+    #[staticmethod]
+    fn from_stl_bytes<'py>(py: Python<'py>, data: &[u8]) -> PyResult<Bound<'py, PyAny>> {
+        let mesh = core(|| TriMesh::from_stl_bytes(data, TriMeshOptions::default()))?;
+        wrap_shape(py, Arc::new(mesh.into()))
+    }
+
+    /// Closest hits of rays in the mesh's own frame: `origins` and `directions` `(N, 3)`
+    /// (finite; directions non-zero, normalised here), up to `max_distance` (>= 0). Returns
+    /// a `MeshRayHits` (`hit`, `distance`, `point`, `normal`, `triangle`, arrays of length
+    /// N). Uses the BVH, releases the GIL and runs in parallel.
+    #[pyo3(signature = (origins, directions, max_distance = f64::INFINITY))]
+    fn raycast(
+        slf: &Bound<'_, Self>,
+        origins: &Bound<'_, PyAny>,
+        directions: &Bound<'_, PyAny>,
+        max_distance: f64,
+    ) -> PyResult<PyMeshRayHits> {
+        let Shape::TriMesh(m) = shape_of(slf) else {
+            return Err(wrong_kind("TriMesh"));
+        };
+        let md = scalar("max_distance", max_distance)?;
+        raycast(slf.py(), m, origins, directions, md)
+    }
+
+    /// Closest points of the mesh (its surface, in its own frame) to `points` `(N, 3)`
+    /// within `max_distance`: `(points (N, 3), distances (N,), triangles (N,) int64)`, NaN
+    /// and -1 where no triangle is within `max_distance`. Releases the GIL.
+    #[pyo3(signature = (points, max_distance = f64::INFINITY))]
+    fn closest_points<'py>(
+        slf: &Bound<'py, Self>,
+        points: &Bound<'py, PyAny>,
+        max_distance: f64,
+    ) -> PyResult<Bound<'py, PyTuple>> {
+        let Shape::TriMesh(m) = shape_of(slf) else {
+            return Err(wrong_kind("TriMesh"));
+        };
+        let md = scalar("max_distance", max_distance)?;
+        closest_points(slf.py(), m, points, md)
+    }
+
+    /// Indices (ascending int64) of the triangles whose bounding boxes overlap the box
+    /// `[aabb_min, aabb_max]` (mesh frame).
+    fn overlapping_triangles<'py>(
+        slf: &Bound<'py, Self>,
+        aabb_min: &Bound<'py, PyAny>,
+        aabb_max: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyArray1<i64>>> {
+        let Shape::TriMesh(m) = shape_of(slf) else {
+            return Err(wrong_kind("TriMesh"));
+        };
+        overlapping(slf.py(), aabb_min, aabb_max, |b| m.overlapping_triangles(b))
+    }
+
+    /// Some hit per ray (the first the BVH walk finds, not necessarily the closest), for
+    /// occlusion tests: same arguments and `MeshRayHits` as `raycast`; `hit` is exact.
+    #[pyo3(signature = (origins, directions, max_distance = f64::INFINITY))]
+    fn raycast_any(
+        slf: &Bound<'_, Self>,
+        origins: &Bound<'_, PyAny>,
+        directions: &Bound<'_, PyAny>,
+        max_distance: f64,
+    ) -> PyResult<PyMeshRayHits> {
+        let m = mesh_of(slf)?;
+        let md = scalar("max_distance", max_distance)?;
+        raycast_with(slf.py(), origins, directions, md, |o, d, t| {
+            let pairs: Vec<(Vec3, Vec3)> = o.iter().copied().zip(d.iter().copied()).collect();
+            Ok(batch::map(&pairs, |(o, d)| m.raycast_any(*o, *d, t)))
+        })
+    }
+
+    /// Every hit of one ray (`origin`, `direction` `(3,)`, direction normalised here) up to
+    /// `max_distance`, as a `MeshRayHits` with one row per hit, sorted by distance then
+    /// triangle (all `hit` true; no rows when the ray misses).
+    #[pyo3(signature = (origin, direction, max_distance = f64::INFINITY))]
+    fn raycast_all(
+        slf: &Bound<'_, Self>,
+        origin: &Bound<'_, PyAny>,
+        direction: &Bound<'_, PyAny>,
+        max_distance: f64,
+    ) -> PyResult<PyMeshRayHits> {
+        let m = mesh_of(slf)?;
+        let md = scalar("max_distance", max_distance)?;
+        check_max_distance(md)?;
+        let o = vec3(origin, "origin")?;
+        let d = vec3(direction, "direction")?;
+        let (o, d) = rays_checked(vec![o], vec![d], ("origin", "direction"))?;
+        let hits = guard(|| Ok(m.raycast_all(o[0], d[0], md)))?;
+        let hits: Vec<Option<MeshRayHit>> = hits.into_iter().map(Some).collect();
+        Ok(hits_out(slf.py(), &hits))
+    }
+
+    /// The mesh with its vertices moved to `vertices` `(V, 3)` (same count, same triangles):
+    /// the BVH is refitted, not rebuilt (deforming meshes), and the edge angles recomputed;
+    /// queries equal those of a freshly built mesh. Shapes are immutable, so this returns a
+    /// new `TriMesh` and leaves this one (and any world holding it) unchanged.
+    fn with_vertices<'py>(
+        slf: &Bound<'py, Self>,
+        vertices: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let (verts, _) = vec3s(vertices, "vertices", false)?;
+        let mut m = mesh_of(slf)?.clone();
+        slf.py().detach(|| core(|| m.set_vertices(verts)))?;
+        wrap_shape(slf.py(), Arc::new(m.into()))
+    }
+
+    /// Triangle index pairs `(i, j)` as an `(N, 2)` int64 array, sorted, where triangle `i`
+    /// of this mesh and triangle `j` of `other` (placed at `pose`, its pose in this mesh's
+    /// frame; default identity) have overlapping bounding boxes in this mesh's frame (the
+    /// box of `j` taken after moving its corners), found by descending both BVHs together.
+    #[pyo3(signature = (other, pose = None))]
+    fn overlapping_triangle_pairs<'py>(
+        slf: &Bound<'py, Self>,
+        other: &Bound<'py, PyTriMesh>,
+        pose: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyArray2<i64>>> {
+        let (a, b) = (mesh_of(slf)?, mesh_of(other)?);
+        let pose = extract_isometry(pose, "pose")?;
+        let pairs = slf
+            .py()
+            .detach(|| guard(|| Ok(a.triangle_pairs(b, &pose))))?;
+        Ok(Array2::from_shape_fn((pairs.len(), 2), |(i, j)| {
+            i64::from(if j == 0 { pairs[i].0 } else { pairs[i].1 })
+        })
+        .into_pyarray(slf.py()))
+    }
+
+    /// Signed dihedral angle (radians) across each triangle edge, `(T, 3)` float64: edge
+    /// `k` runs from corner `k` to corner `k + 1`; positive for convex edges, negative for
+    /// concave ones, 0 for boundary edges (see `edge_neighbors`). Precomputed at
+    /// construction for internal-edge correction of contacts.
+    #[getter]
+    fn edge_angles<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let e = mesh_of(slf)?.edges();
+        Ok(
+            Array2::from_shape_fn((e.len(), 3), |(i, k)| f64::from(e[i][k].angle))
+                .into_pyarray(slf.py()),
+        )
+    }
+
+    /// The triangle across each edge, `(T, 3)` int64 (edge `k` from corner `k` to `k + 1`),
+    /// -1 on boundary edges (one triangle, or more than two sharing the edge).
+    #[getter]
+    fn edge_neighbors<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyArray2<i64>>> {
+        let e = mesh_of(slf)?.edges();
+        Ok(Array2::from_shape_fn((e.len(), 3), |(i, k)| {
+            let n = e[i][k].neighbor;
+            if n == NO_NEIGHBOR {
+                -1
+            } else {
+                i64::from(n)
+            }
+        })
+        .into_pyarray(slf.py()))
+    }
+
+    /// Number of triangles.
+    #[getter]
+    fn num_triangles(slf: &Bound<'_, Self>) -> PyResult<usize> {
+        match shape_of(slf) {
+            Shape::TriMesh(m) => Ok(m.num_triangles()),
+            _ => Err(wrong_kind("TriMesh")),
+        }
+    }
 }

@@ -19,6 +19,7 @@ mod traverse;
 mod tree_insert;
 mod tree_query;
 mod tree_validate;
+mod wide;
 
 pub use build::{MAX_LEAF_SIZE, NUM_BINS};
 pub use dynamic_tree::{DynamicTree, InsertStrategy, TreeProxy};
@@ -26,3 +27,4 @@ pub use static_bvh::{
     Bvh, BvhLayout, Quantization, QuantizedNode, UnquantizedNode, MAX_PRIMITIVES,
 };
 pub use tree_query::HalfSpace;
+pub use wide::WideNode;

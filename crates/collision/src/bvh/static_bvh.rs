@@ -12,6 +12,7 @@
 //! [`Bvh::refit`] recomputes the boxes after primitives moved without changing topology.
 
 use super::build::{build, BuildOutput};
+use super::wide::{collapse, WideNode};
 use crate::error::{CaromError, Result};
 use crate::math::{Aabb, Real, Vec3, EPSILON};
 use serde::{Deserialize, Serialize};
@@ -139,6 +140,9 @@ pub struct Bvh {
     pub(crate) order: Vec<u32>,
     /// Exact bounds of all primitives.
     bounds: Aabb,
+    /// The quantised nodes collapsed to 4-wide nodes for closest-hit rays (`bvh::wide`);
+    /// empty for the unquantised layout and when the root is a leaf.
+    pub(crate) wide: Vec<WideNode>,
 }
 
 /// Encodes a leaf's primitive range.
@@ -219,8 +223,10 @@ impl Bvh {
             })
             .collect();
         let bounds = aabbs[0];
+        let nodes = make_nodes(layout, &aabbs, &data, &bounds);
         Ok(Bvh {
-            nodes: make_nodes(layout, &aabbs, &data, &bounds),
+            wide: wide_nodes(&nodes),
+            nodes,
             order,
             bounds,
         })
@@ -247,13 +253,22 @@ impl Bvh {
         self.order.len()
     }
 
-    /// Bytes used by the nodes and the primitive order.
+    /// Number of 4-wide nodes the quantised layout keeps for closest-hit rays (0 for the
+    /// unquantised layout and for single-leaf hierarchies).
+    pub fn num_wide_nodes(&self) -> usize {
+        self.wide.len()
+    }
+
+    /// Bytes used by the nodes (binary and 4-wide) and the primitive order.
     pub fn memory_bytes(&self) -> usize {
         let nodes = match &self.nodes {
             Nodes::Quantized(v, _) => v.len() * std::mem::size_of::<QuantizedNode>(),
             Nodes::Unquantized(v) => v.len() * std::mem::size_of::<UnquantizedNode>(),
         };
-        nodes + self.order.len() * 4 + std::mem::size_of::<Self>()
+        nodes
+            + self.wide.len() * std::mem::size_of::<WideNode>()
+            + self.order.len() * 4
+            + std::mem::size_of::<Self>()
     }
 
     /// Exact bounds of all primitives.
@@ -264,8 +279,10 @@ impl Bvh {
     /// The same hierarchy in another layout.
     pub fn with_layout(&self, layout: BvhLayout) -> Bvh {
         let (aabbs, data) = self.node_boxes_and_data();
+        let nodes = make_nodes(layout, &aabbs, &data, &self.bounds);
         Bvh {
-            nodes: make_nodes(layout, &aabbs, &data, &self.bounds),
+            wide: wide_nodes(&nodes),
+            nodes,
             order: self.order.clone(),
             bounds: self.bounds,
         }
@@ -299,6 +316,7 @@ impl Bvh {
         }
         self.bounds = aabbs[0];
         self.nodes = make_nodes(self.layout(), &aabbs, &data, &self.bounds);
+        self.wide = wide_nodes(&self.nodes);
         Ok(())
     }
 
@@ -327,6 +345,14 @@ pub(crate) fn right_child(data: &[u32], i: usize) -> usize {
         i + 2
     } else {
         left as usize
+    }
+}
+
+/// The 4-wide nodes of the quantised layout (none for the unquantised one).
+fn wide_nodes(nodes: &Nodes) -> Vec<WideNode> {
+    match nodes {
+        Nodes::Quantized(v, _) => collapse(v),
+        Nodes::Unquantized(_) => Vec::new(),
     }
 }
 

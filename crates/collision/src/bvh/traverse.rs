@@ -13,11 +13,13 @@
 use super::static_bvh::{
     leaf_range, Bvh, Nodes, Quantization, QuantizedNode, UnquantizedNode, LEAF_FLAG,
 };
+use super::wide::{walk_ordered, WideRay};
 use crate::math::{Aabb, Real, Vec3, Vec3A, EPSILON};
 
 /// `1 + 2γ₃` with `γₙ = nε / (1 - nε)` (Ize 2013), plus slack for the quantised mapping and
 /// for the rounding of the leaf test's `t`, so a box is never culled against a tied hit.
-const ROBUST_EXIT: Real = 1.0 + 2.0 * (3.0 * EPSILON / (1.0 - 3.0 * EPSILON)) + 32.0 * EPSILON;
+pub(crate) const ROBUST_EXIT: Real =
+    1.0 + 2.0 * (3.0 * EPSILON / (1.0 - 3.0 * EPSILON)) + 32.0 * EPSILON;
 
 /// A ray prepared for slab tests against the boxes of one layout.
 #[derive(Clone, Copy)]
@@ -58,6 +60,16 @@ impl PreparedRay {
             Real::INFINITY
         }
     }
+}
+
+/// The ray in quantised coordinates (origin, direction) and the outward pad covering the
+/// rounding of the mapping. The affine map keeps the ray parameter `t`.
+#[inline]
+fn quantized_ray(q: &Quantization, origin: Vec3, dir: Vec3) -> (Vec3, Vec3, Vec3) {
+    let o = (origin - q.origin) * q.scale;
+    let d = dir * q.scale;
+    let pad = (o.abs() + Vec3::splat(65536.0)) * (8.0 * EPSILON);
+    (o, d, pad)
 }
 
 /// Node access shared by the two layouts.
@@ -114,10 +126,7 @@ impl NodeSet for QNodes<'_> {
             && n.max[2] >= q.0[2]
     }
     fn ray(&self, origin: Vec3, dir: Vec3) -> PreparedRay {
-        // The affine map to quantised space keeps the ray parameter t.
-        let o = (origin - self.1.origin) * self.1.scale;
-        let d = dir * self.1.scale;
-        let pad = (o.abs() + Vec3::splat(65536.0)) * (8.0 * EPSILON);
+        let (o, d, pad) = quantized_ray(self.1, origin, dir);
         PreparedRay::new(o, d, pad)
     }
     #[inline(always)]
@@ -280,6 +289,8 @@ impl Bvh {
     /// Like [`Bvh::for_each_candidate_on_ray`], but visits the nearer child first and skips
     /// subtrees entered beyond the current `max_t`: the fast path for closest hits. Uses a
     /// small stack of deferred far children (the stackless walk cannot order children).
+    /// The quantised layout walks its 4-wide nodes (`bvh::wide`), the unquantised one its
+    /// binary nodes; both visit every primitive a closest hit needs.
     pub fn for_each_candidate_on_ray_ordered(
         &self,
         origin: Vec3,
@@ -288,6 +299,17 @@ impl Bvh {
         mut f: impl FnMut(u32, &mut Real) -> bool,
     ) {
         let mut max_t = max_t;
+        if let (Nodes::Quantized(_, q), false) = (&self.nodes, self.wide.is_empty()) {
+            let (o, d, pad) = quantized_ray(q, origin, dir);
+            walk_ordered(
+                &self.wide,
+                &self.order,
+                &WideRay::new(o, d, pad),
+                &mut max_t,
+                f,
+            );
+            return;
+        }
         with_nodes!(self, ns => {
             let r = ns.ray(origin, dir);
             if ns.ray_entry(0, &r, max_t) == Real::INFINITY {
@@ -389,7 +411,7 @@ pub(crate) fn right_child_of<N: NodeSet>(ns: &N, i: usize) -> usize {
 
 /// Deferred far children of the ordered ray walk: a fixed array, spilling to the heap only
 /// for trees deeper than it (degenerate inputs), so no allocation per ray.
-struct RayStack {
+pub(crate) struct RayStack {
     fixed: [(u32, Real); 48],
     len: usize,
     spill: Vec<(u32, Real)>,
@@ -397,7 +419,7 @@ struct RayStack {
 
 impl RayStack {
     #[inline]
-    fn new() -> Self {
+    pub(crate) fn new() -> Self {
         RayStack {
             fixed: [(0, 0.0); 48],
             len: 0,
@@ -405,7 +427,7 @@ impl RayStack {
         }
     }
     #[inline]
-    fn push(&mut self, e: (u32, Real)) {
+    pub(crate) fn push(&mut self, e: (u32, Real)) {
         if self.len < self.fixed.len() {
             self.fixed[self.len] = e;
             self.len += 1;
@@ -414,7 +436,7 @@ impl RayStack {
         }
     }
     #[inline]
-    fn pop(&mut self) -> Option<(u32, Real)> {
+    pub(crate) fn pop(&mut self) -> Option<(u32, Real)> {
         if let Some(e) = self.spill.pop() {
             return Some(e);
         }

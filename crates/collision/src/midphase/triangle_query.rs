@@ -68,7 +68,7 @@ impl WatertightRay {
     }
 
     /// The hit on `tri` with `t ∈ [0, max_t]`, if any.
-    #[inline]
+    #[inline(always)]
     pub fn intersect(&self, tri: &[Vec3; 3], max_t: Real) -> Option<TriangleRayHit> {
         let [kx, ky, kz] = self.k;
         let (sx, sy, sz) = (self.shear.x, self.shear.y, self.shear.z);
