@@ -15,6 +15,7 @@ use super::polyhedron::{
     plane_polyhedron_manifold, polyhedron_manifold_guided, polyhedron_manifold_into, Polyhedron,
     SAT_MAX_EDGE_PAIRS,
 };
+use super::triangle_cuboid::triangle_cuboid_manifold_into;
 use crate::error::{CaromError, Result};
 use crate::math::{Isometry, Real};
 use crate::query::contact::{contact_convex_plane, contact_plane_convex};
@@ -130,6 +131,11 @@ pub fn convex_convex_into(
             true
         }
         (_, C::Capsule(_)) if as_polyhedron(a).is_some() => swapped(out),
+        (C::Triangle(t), C::Cuboid(c)) => {
+            triangle_cuboid_manifold_into(t, c, pose_ab, pred, out);
+            true
+        }
+        (C::Cuboid(_), C::Triangle(_)) => swapped(out),
         _ => match (as_polyhedron(a), as_polyhedron(b)) {
             (Some(pa), Some(pb)) => {
                 if pa.flat || pb.flat || pa.edges().len() * pb.edges().len() <= SAT_MAX_EDGE_PAIRS {

@@ -94,9 +94,25 @@ impl ContactManifold {
         if self.points.is_empty() {
             return false;
         }
+        // cos(COHERENCE_ANGLE / 2), the bound on |q0 · q| (the relative rotation's half angle).
         let cos_half = (0.5 * COHERENCE_ANGLE).cos();
-        if p0.rotation.dot(pose_ab.rotation).abs() < cos_half {
+        let c = p0.rotation.dot(pose_ab.rotation).abs();
+        if c < cos_half {
             return false;
+        }
+        // Cheap sufficient test first: a point x moves by at most |Δt| + 2 sin(θ/2) |x|
+        // (θ the relative rotation angle), so no per-point transform is needed while the
+        // pose has (nearly) not changed, the common case of resting contacts.
+        let sin_half = (1.0 - c * c).max(0.0).sqrt();
+        let dt = (pose_ab.translation - p0.translation).length();
+        let reach = self
+            .points
+            .iter()
+            .map(|p| p.local_b.length_squared())
+            .fold(0.0, Real::max)
+            .sqrt();
+        if dt + 2.0 * sin_half * reach <= COHERENCE_DISTANCE {
+            return true;
         }
         let tol2 = COHERENCE_DISTANCE * COHERENCE_DISTANCE;
         self.points.iter().all(|p| {
@@ -115,10 +131,17 @@ impl ContactManifold {
     /// whose distance exceeds `breaking_threshold` or whose witness points drifted
     /// tangentially by more than `breaking_threshold`.
     pub fn refresh(&mut self, pose_a: &Isometry, pose_b: &Isometry, breaking_threshold: Real) {
+        if self.points.is_empty() {
+            return;
+        }
+        // Rotation matrices once per manifold: three matrix–vector products per point are
+        // cheaper than three quaternion rotations.
+        let (ra, rb) = (pose_a.rotation_matrix(), pose_b.rotation_matrix());
+        let (ta, tb) = (pose_a.translation, pose_b.translation);
         self.points.retain_mut(|p| {
-            let a = pose_a.transform_point(p.local_a);
-            let b = pose_b.transform_point(p.local_b);
-            let n = pose_b.transform_vector(p.local_normal_b);
+            let a = ra * p.local_a + ta;
+            let b = rb * p.local_b + tb;
+            let n = rb * p.local_normal_b;
             let d = (a - b).dot(n);
             if d.is_nan() || d > breaking_threshold {
                 return false;

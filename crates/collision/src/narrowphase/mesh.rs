@@ -65,8 +65,22 @@ impl ContactTriangles for HeightField {
     }
 }
 
-/// World (here: mesh-frame) box of convex `b` at `pose_ab`, from six support queries.
+/// World (here: mesh-frame) box of convex `b` at `pose_ab`: closed forms for spheres,
+/// capsules and boxes (Arvo's transformed box), else six support queries.
 pub fn convex_aabb(b: ConvexRef<'_>, pose_ab: &Isometry) -> crate::math::Aabb {
+    match b {
+        ConvexRef::Sphere(s) => {
+            return Aabb::from_center_half_extents(pose_ab.translation, Vec3::splat(s.radius()))
+        }
+        ConvexRef::Capsule(c) => {
+            let (p, q) = c.segment();
+            let (p, q) = (pose_ab.transform_point(p), pose_ab.transform_point(q));
+            let r = Vec3::splat(c.radius());
+            return Aabb::new(p.min(q) - r, p.max(q) + r);
+        }
+        ConvexRef::Cuboid(c) => return c.local_aabb().transformed(pose_ab),
+        _ => {}
+    }
     let mut min = Vec3::ZERO;
     let mut max = Vec3::ZERO;
     for i in 0..3 {

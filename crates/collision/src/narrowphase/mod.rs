@@ -5,7 +5,8 @@
 //! - [`pipeline`]: the [`NarrowPhase`] stage of the collision world (events, sensors);
 //! - [`polyhedron`]: SAT with Gauss-map pruning and face clipping for boxes (box–box
 //!   clipping), hulls and triangles, and plane–polyhedron; [`convex`]: analytic manifolds for round shapes and
-//!   multi-point by perturbation; [`mesh`]: convex against triangle meshes and compounds
+//!   multi-point by perturbation; [`triangle_cuboid`]: the triangle–box special case of the
+//!   separating-axis test; [`mesh`]: convex against triangle meshes and compounds
 //!   with internal-edge correction; [`dispatcher`]: the shape-pair table.
 
 pub mod contact;
@@ -19,6 +20,7 @@ pub mod convex;
 pub mod dispatcher;
 pub mod mesh;
 pub mod polyhedron;
+pub mod triangle_cuboid;
 
 pub use dispatcher::{Dispatcher, Generated, UserAlgorithm};
 pub mod pipeline;

@@ -10,7 +10,9 @@
 
 use super::closest_points::closest_points_segment_segment;
 use super::contact_convex::contact_gjk_epa;
+use super::gjk::{gjk, GjkResult};
 use super::result::Contact;
+use super::support_adapters::{Core, Transformed};
 use crate::math::{Isometry, Mat3, Real, Vec3, EPSILON};
 use crate::shape::{ConvexRef, Cuboid};
 
@@ -34,12 +36,16 @@ pub fn contact_cuboid_cuboid(
     let t = pose_ab.translation;
     let bx = [rot.x_axis, rot.y_axis, rot.z_axis];
     let mut best: Option<(Real, Vec3, Axis)> = None;
+    // The separating axis found, if any (its overlap is negative: minus the gap).
+    let mut sep: Option<(Real, Vec3)> = None;
     let mut test = |axis: Vec3, kind: Axis| -> bool {
         let ra = ha.x * axis.x.abs() + ha.y * axis.y.abs() + ha.z * axis.z.abs();
         let rb = (0..3).map(|j| hb[j] * axis.dot(bx[j]).abs()).sum::<Real>();
         let dist = axis.dot(t);
         let overlap = ra + rb - dist.abs();
         if overlap < 0.0 {
+            let n = if dist < 0.0 { -axis } else { axis };
+            sep = Some((overlap, n));
             return false;
         }
         if best.is_none_or(|(d, _, _)| overlap < d) {
@@ -72,12 +78,42 @@ pub fn contact_cuboid_cuboid(
         }
     }
     if !overlapping {
-        return contact_gjk_epa(
-            ConvexRef::Cuboid(a),
-            ConvexRef::Cuboid(b),
-            pose_ab,
-            prediction,
-        );
+        let Some((overlap, n)) = sep else {
+            return contact_gjk_epa(
+                ConvexRef::Cuboid(a),
+                ConvexRef::Cuboid(b),
+                pose_ab,
+                prediction,
+            );
+        };
+        let core_b = Transformed::new(Core(ConvexRef::Cuboid(b)), pose_ab);
+        return match gjk(&Core(ConvexRef::Cuboid(a)), &core_b, -t, prediction) {
+            GjkResult::BeyondMaxDistance => None,
+            GjkResult::Separated {
+                distance,
+                point_a,
+                point_b,
+            } => (distance <= prediction).then(|| Contact {
+                distance,
+                point_a,
+                point_b,
+                normal: (point_b - point_a) / distance,
+            }),
+            // A separating axis exists, yet GJK counts the boxes as overlapping: they touch
+            // within round-off, where EPA's polytope is degenerate (it reported depths of
+            // metres in the polytope oracle). GJK's witnesses are the touching points and
+            // the separating axis is the normal.
+            GjkResult::Overlapping(simplex) => {
+                let (point_a, _) = simplex.witnesses();
+                let gap = -overlap;
+                (gap <= prediction).then_some(Contact {
+                    distance: gap,
+                    point_a,
+                    point_b: point_a + n * gap,
+                    normal: n,
+                })
+            }
+        };
     }
     let (depth, n, kind) = best.expect("at least the face axes were tested");
     if -depth > prediction {
@@ -157,7 +193,7 @@ fn face_witness(hr: Vec3, hi: Vec3, rot: &Mat3, t: Vec3, i: usize, n: Vec3) -> (
     let (k1, k2) = ((j + 1) % 3, (j + 2) % 3);
     let centre = t + m * hi[j];
     let (u, v) = (axes[k1] * hi[k1], axes[k2] * hi[k2]);
-    let mut poly: Vec<Vec3> = vec![
+    let mut poly: Poly = smallvec::smallvec![
         centre + u + v,
         centre - u + v,
         centre - u - v,
@@ -186,9 +222,12 @@ fn face_witness(hr: Vec3, hi: Vec3, rot: &Mat3, t: Vec3, i: usize, n: Vec3) -> (
     (point_ref, deepest)
 }
 
+/// A clipped face: at most 8 corners (a quadrilateral clipped by four planes), on the stack.
+type Poly = smallvec::SmallVec<[Vec3; 8]>;
+
 /// Sutherland–Hodgman clip of `poly` to `sign * x[k] <= limit`.
-fn clip(poly: &[Vec3], k: usize, sign: Real, limit: Real) -> Vec<Vec3> {
-    let mut out = Vec::with_capacity(poly.len() + 2);
+fn clip(poly: &[Vec3], k: usize, sign: Real, limit: Real) -> Poly {
+    let mut out = Poly::new();
     for idx in 0..poly.len() {
         let p = poly[idx];
         let q = poly[(idx + 1) % poly.len()];
