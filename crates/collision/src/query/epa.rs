@@ -28,6 +28,9 @@ pub const EPA_MAX_ITERATIONS: usize = 128;
 /// Relative tolerance on the gap between a face and the support point along its normal.
 pub const EPA_REL_TOL: Real = 64.0 * EPSILON;
 
+/// Cosine above which two polytope faces count as coplanar in the final tie-break (~2.6°).
+const COPLANAR_COS: Real = 0.999;
+
 /// Penetration of A and B: translating B by `depth * normal` makes them touch.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Penetration {
@@ -356,17 +359,20 @@ fn expand<A: Support, B: Support>(
         }
     }
     // Coplanar faces tie on distance; the origin's projection lies inside only one of them.
-    // Among the faces within tolerance of the best, take the one whose triangle is truly
-    // closest to the origin, so the witnesses satisfy `a - b = depth * normal`.
+    // Among the faces within tolerance of the best *and parallel to it*, take the one whose
+    // triangle is truly closest to the origin, so the witnesses satisfy
+    // `a - b = depth * normal`. The parallel test matters when the shapes merely touch: the
+    // polytope is then a thin slab through the origin, and its opposite face (normal
+    // reversed, as close to the origin) would otherwise win the tie and flip the normal
+    // (a box resting on a large ground box got the ground's bottom face, 102 m deep).
     let (verts, faces) = (&scratch.verts, &scratch.faces);
     let best = faces[best_i as usize];
     let slack = EPA_REL_TOL * scale.max(EPSILON) * 4.0;
     let mut pick = best;
     let mut pick_d = Real::INFINITY;
-    for f in faces
-        .iter()
-        .filter(|f| !f.removed && f.dist <= best.dist + slack)
-    {
+    for f in faces.iter().filter(|f| {
+        !f.removed && f.dist <= best.dist + slack && f.normal.dot(best.normal) >= COPLANAR_COS
+    }) {
         let tri = [
             verts[f.idx[0] as usize].w,
             verts[f.idx[1] as usize].w,
