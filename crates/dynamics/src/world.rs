@@ -25,7 +25,9 @@ pub struct WorldParams {
     pub solver: SolverParams,
     /// Sleeping settings.
     pub sleep: SleepParams,
-    /// Implicit gyroscopic term (see [`crate::integrate`]).
+    /// Include the gyroscopic term, solved implicitly in body space with one Newton step
+    /// (Bullet's `computeGyroscopicImpulseImplicit_Body`), which keeps fast, thin spinning
+    /// bodies stable.
     pub gyroscopic: bool,
     /// Solve large colours in parallel (with the `parallel` feature). Results are
     /// bit-identical either way.
