@@ -199,8 +199,8 @@ impl<'w> WorldQuery<'w> {
 }
 
 impl World {
-    /// A query structure over the bodies with a shape, at their current poses (see the
-    /// module docs of `queries`).
+    /// A query structure over the bodies with a shape, at their current poses (see
+    /// [`crate::pipeline::queries`]).
     pub fn query(&self) -> Result<WorldQuery<'_>> {
         let set = self.bodies();
         let mut objects = Vec::new();

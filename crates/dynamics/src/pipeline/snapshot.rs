@@ -155,7 +155,7 @@ impl ShapeTable {
 }
 
 impl World {
-    /// Saves the whole world to bytes (see the module docs of `snapshot` for the format and
+    /// Saves the whole world to bytes (see [`crate::pipeline::snapshot`] for the format and
     /// what is stored). [`World::from_bytes`] restores it exactly.
     pub fn to_bytes(&self) -> Result<Vec<u8>> {
         let mut table = ShapeTable::default();
