@@ -478,6 +478,7 @@ class World:
         dt: float = 1.0 / 60.0,
         method: str = "hgrid",
         sleeping: bool = True,
+        solver: str = "soft_step",
     ) -> World: ...
     def add_body(
         self,

@@ -27,9 +27,11 @@ def anchored(dt: float = 1 / 120, gravity=(0.0, -G, 0.0)) -> tuple[carom.World, 
     return w, anchor
 
 
-def test_pendulum_on_a_ball_joint_keeps_its_period() -> None:
+@pytest.mark.parametrize("solver, tol", [("sequential_impulse", 0.005), ("soft_step", 0.04)])
+def test_pendulum_on_a_ball_joint_keeps_its_period(solver: str, tol: float) -> None:
     length, r, theta0 = 1.0, 0.05, 0.08
-    w, anchor = anchored()
+    w = carom.World(gravity=[0, -G, 0], dt=1 / 120, sleeping=False, solver=solver)
+    anchor = w.add_body(carom.Box([0.05] * 3), [0, 5, 0, 0, 0, 0, 1], is_static=True)
     bob_pos = [length * math.sin(theta0), 5 - length * math.cos(theta0), 0]
     bob = w.add_body(carom.Sphere(r), bob_pos + [0, 0, 0, 1], mass=1.0)
     # The joint point is the pivot: anchor origin, and pivot - bob in the bob's frame.
@@ -46,10 +48,10 @@ def test_pendulum_on_a_ball_joint_keeps_its_period() -> None:
     period = float(np.mean(np.diff(t)))
     # Physical pendulum: T = 2π √(I_pivot / (m g L)), I_pivot = 2/5 m r² + m L².
     analytic = 2 * math.pi * math.sqrt((0.4 * r * r + length * length) / (G * length))
-    # Measured: 3.4 % long at every dt from 1/60 to 1/480 s with the default soft-step
-    # solver (its soft joints; see the report), so the bound is "a few %", not tighter.
-    assert period == pytest.approx(analytic, rel=0.04)
-    assert period == pytest.approx(2 * math.pi * math.sqrt(length / G), rel=0.04)
+    # Sequential impulses: 0.04 % off. The default soft step's 60 Hz soft joints make it
+    # 3.4 % long at every dt from 1/60 to 1/480 s (0.3 % at 240 Hz), hence its bound.
+    assert period == pytest.approx(analytic, rel=tol)
+    assert period == pytest.approx(2 * math.pi * math.sqrt(length / G), rel=tol + 0.001)
     # The bob stays on the sphere of radius L about the pivot.
     p = w.poses([bob])[0, :3]
     assert np.linalg.norm(p - [0, 5, 0]) == pytest.approx(length, abs=0.01)
@@ -230,6 +232,11 @@ def test_joint_to_a_removed_body_is_removed_and_the_world_stays_sound() -> None:
     assert w.poses([links[3]])[0, 1] < 4.0 and w.poses([fresh])[0, 1] < 4.0
     w.remove_joint(joints[1])
     assert w.joints() == joints[:1]
+
+
+def test_bad_solver_name_raises() -> None:
+    with pytest.raises(ValueError, match="solver"):
+        carom.World(solver="magic")
 
 
 def test_bad_joint_input_raises_and_changes_nothing() -> None:

@@ -22,7 +22,7 @@ use crate::world_queries::{bits, PyWorldContacts, PyWorldRayHit, PyWorldShapeCas
 use crate::world_snapshot::{decode, encode};
 use carom_collision::broadphase::{Filter, Method};
 use carom_collision::math::{check_finite_vec, Isometry, Real};
-use carom_dynamics::{BodyDesc, BodyHandle, BodyType, MassSpec, PipelineParams, World};
+use carom_dynamics::{BodyDesc, BodyHandle, BodyType, MassSpec, PipelineParams, SolverKind, World};
 use numpy::ndarray::Array2;
 use numpy::IntoPyArray;
 use pyo3::prelude::*;
@@ -37,7 +37,9 @@ fn handle(b: u64) -> BodyHandle {
 
 /// A rigid-body world. `gravity` (3,) in m/s², `dt` the step of `step()` in seconds,
 /// `method` the broadphase ("hgrid", "grid", "tree", "tree_manhattan", "sap",
-/// "sort_sweep", "brute_force"), `sleeping` whether resting islands fall asleep.
+/// "sort_sweep", "brute_force"), `sleeping` whether resting islands fall asleep, `solver`
+/// "soft_step" (Box2D v3's substepping soft step, the default) or "sequential_impulse"
+/// (Bullet's, with split impulses).
 ///
 /// `add_body(shape, pose, ...)` returns an int handle; `step(n)` advances `n` steps of
 /// `dt`; `poses()` / `velocities()` read every body in one call, `set_poses` /
@@ -67,12 +69,15 @@ impl PyWorld {
 #[pymethods]
 impl PyWorld {
     #[new]
-    #[pyo3(signature = (gravity = None, dt = 1.0 / 60.0, method = "hgrid", sleeping = true))]
+    #[pyo3(signature = (
+        gravity = None, dt = 1.0 / 60.0, method = "hgrid", sleeping = true, solver = "soft_step"
+    ))]
     fn new(
         gravity: Option<&Bound<'_, PyAny>>,
         dt: f64,
         method: &str,
         sleeping: bool,
+        solver: &str,
     ) -> PyResult<Self> {
         let mut params = PipelineParams::default();
         if let Some(g) = gravity {
@@ -80,6 +85,15 @@ impl PyWorld {
         }
         params.dynamics.sleep.enabled = sleeping;
         params.broadphase = core(|| method.parse::<Method>())?;
+        params.dynamics.solver.kind = match solver {
+            "soft_step" => SolverKind::SoftStep,
+            "sequential_impulse" => SolverKind::SequentialImpulse,
+            other => {
+                return Err(invalid(format!(
+                    "invalid solver = {other:?}: expected \"soft_step\" or \"sequential_impulse\""
+                )))
+            }
+        };
         let dt_r = scalar("dt", dt)?;
         if !(dt_r > 0.0 && dt_r.is_finite()) {
             return Err(invalid(format!("dt must be finite and > 0, got {dt}")));

@@ -41,9 +41,9 @@
 //! its own speed.
 
 mod contacts;
-mod queries;
+pub mod queries;
 mod scene;
-mod snapshot;
+pub mod snapshot;
 mod step;
 
 pub use queries::{BodyRayHit, BodyShapeCastHit, WorldQuery};

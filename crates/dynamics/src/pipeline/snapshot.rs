@@ -155,7 +155,7 @@ impl ShapeTable {
 }
 
 impl World {
-    /// Saves the whole world to bytes (see the module docs of `snapshot` for the format and
+    /// Saves the whole world to bytes (see [`crate::pipeline::snapshot`] for the format and
     /// what is stored). [`World::from_bytes`] restores it exactly.
     pub fn to_bytes(&self) -> Result<Vec<u8>> {
         let mut table = ShapeTable::default();
@@ -363,7 +363,9 @@ fn restore(snap: Snapshot) -> Result<World> {
             continue;
         };
         world.collision.set_pose_with_margin(h, o.pose, o.margin)?;
-        world.collision.set_resting(h, o.resting)?;
+        // Resting during the rebuild update, so it generates no contacts that the saved
+        // manifolds would replace anyway; the saved hint is set after it.
+        world.collision.set_resting(h, true)?;
         let b = o.body as usize;
         if !world.dynamics.bodies().is_alive_checked(b) || world.object_of[b].is_some() {
             return Err(corrupt(format!("object {k} names body slot {b}")));
@@ -375,6 +377,11 @@ fn restore(snap: Snapshot) -> Result<World> {
         world.collision.remove(h)?;
     }
     world.collision.update()?;
+    for o in &snap.objects {
+        if let Some(h) = world.object_of[o.body as usize] {
+            world.collision.set_resting(h, o.resting)?;
+        }
+    }
 
     // The persistent manifolds: saved state for the saved pairs, a fresh manifold for a pair
     // the saved world did not have yet (as a newly added pair would get).
@@ -436,4 +443,91 @@ fn restore(snap: Snapshot) -> Result<World> {
         ..Default::default()
     };
     Ok(world)
+}
+
+#[cfg(test)]
+mod tests {
+    //! Payloads that pass the checksum but carry inconsistent content are rejected by the
+    //! structural checks, never by a panic later.
+    use super::*;
+    use crate::body::BodyDesc;
+    use carom_collision::math::Vec3;
+    use carom_collision::shape::Cuboid;
+
+    fn world() -> World {
+        let mut w = World::new(PipelineParams::default()).unwrap();
+        let s = Arc::new(Shape::from(Cuboid::new(Vec3::splat(0.5)).unwrap()));
+        w.add_body(&BodyDesc::fixed(s.clone(), Isometry::IDENTITY))
+            .unwrap();
+        for i in 0..3 {
+            let p = Isometry::from_translation(Vec3::new(0.0, 1.0 + i as Real, 0.0));
+            w.add_body(&BodyDesc::dynamic(s.clone(), p, 100.0)).unwrap();
+        }
+        w.step(1.0 / 60.0).unwrap();
+        w
+    }
+
+    fn encode(snap: &Snapshot) -> Vec<u8> {
+        let payload = postcard::to_allocvec(snap).unwrap();
+        let mut out = SNAPSHOT_MAGIC.to_vec();
+        out.extend_from_slice(&SNAPSHOT_VERSION.to_le_bytes());
+        out.push(std::mem::size_of::<Real>() as u8);
+        out.extend_from_slice(&checksum(&payload).to_le_bytes());
+        out.extend_from_slice(&payload);
+        out
+    }
+
+    #[test]
+    fn inconsistent_content_is_an_error() {
+        let bytes = world().to_bytes().unwrap();
+        assert_eq!(
+            encode(&decode(&bytes).unwrap()),
+            bytes,
+            "test encoder matches"
+        );
+        type Tamper = (&'static str, fn(&mut Snapshot));
+        let tamper: [Tamper; 9] = [
+            ("shape index", |s| s.body_shapes[1] = Some(99)),
+            ("object shape", |s| s.objects[0].shape = 7),
+            ("object body", |s| s.objects[1].body = 40),
+            ("object slot", |s| s.objects[1].index = 1000),
+            ("repeated slot", |s| s.objects[2].index = s.objects[1].index),
+            ("per-body arrays", |s| {
+                s.radius.pop();
+            }),
+            ("accumulator", |s| s.accumulator = Real::NAN),
+            ("method", |s| s.broadphase = "octree".into()),
+            ("event kind", |s| {
+                s.events.push(EventSnap {
+                    a: 0,
+                    b: 1,
+                    kind: 9,
+                    sensor: false,
+                })
+            }),
+        ];
+        for (what, f) in tamper {
+            let mut snap = decode(&bytes).unwrap();
+            f(&mut snap);
+            assert!(
+                World::from_bytes(&encode(&snap)).is_err(),
+                "{what} accepted"
+            );
+        }
+        // Body sets with slots out of range or arrays of different lengths.
+        let mut snap = decode(&bytes).unwrap();
+        snap.bodies.woken_by_user.push(999);
+        assert!(
+            World::from_bytes(&encode(&snap)).is_err(),
+            "bad woken slot accepted"
+        );
+        let mut snap = decode(&bytes).unwrap();
+        snap.bodies.position.pop();
+        assert!(
+            World::from_bytes(&encode(&snap)).is_err(),
+            "short array accepted"
+        );
+        // The untouched payload still restores.
+        assert!(World::from_bytes(&encode(&decode(&bytes).unwrap())).is_ok());
+    }
 }
