@@ -132,8 +132,10 @@ pub(crate) enum Nodes {
 }
 
 /// A static BVH over primitive boxes (triangles, heightfield cells, compound children).
-/// Build with [`Bvh::new`]; query with the traversals in `bvh::traverse`.
+/// Build with [`Bvh::new`]; query with the traversals in `bvh::traverse`. Serialised without
+/// its 4-wide nodes, which are derived from the binary ones when loading.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(from = "BvhData", into = "BvhData")]
 pub struct Bvh {
     pub(crate) nodes: Nodes,
     /// Primitive indices; a leaf covers a contiguous range.
@@ -143,6 +145,35 @@ pub struct Bvh {
     /// The quantised nodes collapsed to 4-wide nodes for closest-hit rays (`bvh::wide`);
     /// empty for the unquantised layout and when the root is a leaf.
     pub(crate) wide: Vec<WideNode>,
+}
+
+/// The serialised form of a [`Bvh`]: everything but the derived 4-wide nodes.
+#[derive(Serialize, Deserialize)]
+struct BvhData {
+    nodes: Nodes,
+    order: Vec<u32>,
+    bounds: Aabb,
+}
+
+impl From<BvhData> for Bvh {
+    fn from(d: BvhData) -> Self {
+        Bvh {
+            wide: wide_nodes(&d.nodes),
+            nodes: d.nodes,
+            order: d.order,
+            bounds: d.bounds,
+        }
+    }
+}
+
+impl From<Bvh> for BvhData {
+    fn from(b: Bvh) -> Self {
+        BvhData {
+            nodes: b.nodes,
+            order: b.order,
+            bounds: b.bounds,
+        }
+    }
 }
 
 /// Encodes a leaf's primitive range.
