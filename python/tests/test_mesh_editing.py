@@ -55,6 +55,14 @@ def test_raycast_any_and_all_against_brute_force() -> None:
         if anyhit.hit[i]:
             # Some real hit: its distance is the parameter of the triangle it reports.
             assert t[anyhit.triangle[i]] == pytest.approx(anyhit.distance[i], abs=20 * TOL)
+        if closest.hit[i]:
+            # The barycentric weights rebuild the hit point from the triangle's corners.
+            w = closest.barycentric[i]
+            assert (w >= -1e-6).all() and w.sum() == pytest.approx(1.0, abs=1e-5)
+            corners = tri[closest.triangle[i]]
+            np.testing.assert_allclose(w @ corners, closest.point[i], atol=20 * TOL)
+        else:
+            assert np.isnan(closest.barycentric[i]).all()
         every = mesh.raycast_all(origins[i], dirs[i])
         assert every.hit.all() and len(every.distance) == len(finite)
         np.testing.assert_allclose(every.distance, finite, atol=20 * TOL)

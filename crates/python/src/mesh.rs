@@ -23,8 +23,9 @@ use std::sync::Arc;
 
 /// Closest ray hits on a mesh, one row per ray: `hit` `(N,)` bool, `distance` `(N,)` along
 /// the unit direction, `point` `(N, 3)`, `normal` `(N, 3)` (the triangle's counter-clockwise
-/// face normal, not flipped towards the ray) and `triangle` `(N,)` int64; misses hold NaN
-/// and triangle -1. In the mesh's own frame.
+/// face normal, not flipped towards the ray), `triangle` `(N,)` int64 and `barycentric`
+/// `(N, 3)` (weights of the triangle's corners, in its index order); misses hold NaN and
+/// triangle -1. In the mesh's own frame.
 #[pyclass(name = "MeshRayHits", module = "carom", frozen, get_all)]
 pub struct PyMeshRayHits {
     /// `(N,)` bool: the ray hit the mesh.
@@ -37,6 +38,9 @@ pub struct PyMeshRayHits {
     normal: Py<PyArray2<f64>>,
     /// `(N,)` int64 index of the triangle hit (-1 for misses).
     triangle: Py<PyArray1<i64>>,
+    /// `(N, 3)` barycentric weights of the hit triangle's corners at the hit point
+    /// (non-negative, summing to 1; NaN for misses).
+    barycentric: Py<PyArray2<f64>>,
 }
 
 /// Rays from `(N, 3)` arrays (or `(3,)` for one ray): finite origins, non-zero finite
@@ -141,6 +145,10 @@ fn hits_out(py: Python<'_>, hits: &[Option<MeshRayHit>]) -> PyMeshRayHits {
     let nan = Vec3::splat(Real::NAN);
     let points: Vec<Vec3> = hits.iter().map(|h| h.map_or(nan, |h| h.point)).collect();
     let normals: Vec<Vec3> = hits.iter().map(|h| h.map_or(nan, |h| h.normal)).collect();
+    let bary: Vec<Vec3> = hits
+        .iter()
+        .map(|h| h.map_or(nan, |h| Vec3::from(h.barycentric)))
+        .collect();
     PyMeshRayHits {
         hit: PyArray1::from_vec(py, hits.iter().map(Option::is_some).collect()).unbind(),
         distance: PyArray1::from_vec(
@@ -159,6 +167,7 @@ fn hits_out(py: Python<'_>, hits: &[Option<MeshRayHit>]) -> PyMeshRayHits {
                 .collect(),
         )
         .unbind(),
+        barycentric: vec3s_out(py, &bary).unbind(),
     }
 }
 
