@@ -13,7 +13,7 @@ use crate::pose::extract_isometry;
 use crate::shape::PyShape;
 use crate::shapes::{init, shape_of, wrap_shape, wrong_kind};
 use carom_collision::math::{vec3_to_f64, Aabb, Real, Vec3};
-use carom_collision::midphase::MeshRayHit;
+use carom_collision::midphase::{MeshPointProjection, MeshRayHit};
 use carom_collision::shape::{HeightField, Shape, TriMesh, TriMeshOptions, NO_NEIGHBOR};
 use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray1, PyArray2};
@@ -179,10 +179,35 @@ pub fn closest_points<'py>(
     points: &Bound<'py, PyAny>,
     max_distance: Real,
 ) -> PyResult<Bound<'py, PyTuple>> {
+    closest_points_with(py, points, max_distance, |pts, md| {
+        mesh.closest_point_batch(pts, md)
+    })
+}
+
+/// `heightfield.closest_points(points, max_distance)`, by `HeightField::closest_point`.
+pub fn closest_points_heightfield<'py>(
+    py: Python<'py>,
+    hf: &HeightField,
+    points: &Bound<'py, PyAny>,
+    max_distance: Real,
+) -> PyResult<Bound<'py, PyTuple>> {
+    closest_points_with(py, points, max_distance, |pts, md| {
+        batch::map(pts, |p| hf.closest_point(*p, md))
+    })
+}
+
+/// Batch closest points with `query(points, max_distance)` (GIL released) as the
+/// `(points, distances, triangles)` tuple.
+fn closest_points_with<'py>(
+    py: Python<'py>,
+    points: &Bound<'py, PyAny>,
+    max_distance: Real,
+    query: impl Fn(&[Vec3], Real) -> Vec<Option<MeshPointProjection>> + Send + Sync,
+) -> PyResult<Bound<'py, PyTuple>> {
     check_max_distance(max_distance)?;
     let (pts, _) = vec3s(points, "points", true)?;
     require_finite("points", &pts)?;
-    let res = py.detach(|| guard(|| Ok(mesh.closest_point_batch(&pts, max_distance))))?;
+    let res = py.detach(|| guard(|| Ok(query(&pts, max_distance))))?;
     let nan = Vec3::splat(Real::NAN);
     let cp: Vec<Vec3> = res.iter().map(|r| r.map_or(nan, |r| r.point)).collect();
     let dist: Vec<f64> = res
