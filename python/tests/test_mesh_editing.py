@@ -12,7 +12,7 @@ import pytest
 import carom
 
 from conftest import TOL
-from test_mesh_queries import grid_mesh, moller_trumbore
+from test_mesh_queries import closest_on_triangle, grid_mesh, heightfield_triangles, moller_trumbore
 
 CUBE_V = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)], dtype=float)
 # Outward counter-clockwise triangles of the cube above (vertex i = 4x + 2y + z bits).
@@ -55,6 +55,14 @@ def test_raycast_any_and_all_against_brute_force() -> None:
         if anyhit.hit[i]:
             # Some real hit: its distance is the parameter of the triangle it reports.
             assert t[anyhit.triangle[i]] == pytest.approx(anyhit.distance[i], abs=20 * TOL)
+        if closest.hit[i]:
+            # The barycentric weights rebuild the hit point from the triangle's corners.
+            w = closest.barycentric[i]
+            assert (w >= -1e-6).all() and w.sum() == pytest.approx(1.0, abs=1e-5)
+            corners = tri[closest.triangle[i]]
+            np.testing.assert_allclose(w @ corners, closest.point[i], atol=20 * TOL)
+        else:
+            assert np.isnan(closest.barycentric[i]).all()
         every = mesh.raycast_all(origins[i], dirs[i])
         assert every.hit.all() and len(every.distance) == len(finite)
         np.testing.assert_allclose(every.distance, finite, atol=20 * TOL)
@@ -244,3 +252,21 @@ def test_compound_editing_bad_input_changes_nothing() -> None:
     assert moved.num_children == 2
     cw.step()
     assert len(cw.pairs()) == 1 and set(cw.pairs()[0].tolist()) == {h, probe}
+
+
+def test_heightfield_closest_points_against_brute_force() -> None:
+    rng = np.random.default_rng(18)
+    heights = rng.uniform(-0.4, 0.4, (5, 6))
+    hf = carom.HeightField(heights, cell_size=(0.5, 0.3))
+    tri = heightfield_triangles(heights, 0.5, 0.3)
+    pts = rng.uniform(-2, 2, (40, 3))
+    cp, dist, tris = hf.closest_points(pts)
+    for i, p in enumerate(pts):
+        d = np.linalg.norm(np.array([closest_on_triangle(p, *t) for t in tri]) - p, axis=1)
+        assert dist[i] == pytest.approx(d.min(), abs=10 * TOL)
+        assert np.linalg.norm(cp[i] - p) == pytest.approx(d.min(), abs=10 * TOL)
+        assert d[tris[i]] == pytest.approx(d.min(), abs=10 * TOL)
+    _, far, ft = hf.closest_points(pts + [0, 20, 0], max_distance=1.0)
+    assert np.isnan(far).all() and (ft == -1).all()
+    with pytest.raises(carom.CaromError, match="points"):
+        hf.closest_points([[np.nan, 0, 0]])

@@ -167,6 +167,22 @@ impl PyHeightField {
         crate::mesh::raycast_heightfield(slf.py(), h, origins, directions, md)
     }
 
+    /// Closest points of the heightfield's surface (its own frame) to `points` `(N, 3)`
+    /// within `max_distance`: `(points (N, 3), distances (N,), triangles (N,) int64)`, NaN
+    /// and -1 where no triangle is within `max_distance`, as `TriMesh.closest_points`.
+    #[pyo3(signature = (points, max_distance = f64::INFINITY))]
+    fn closest_points<'py>(
+        slf: &Bound<'py, Self>,
+        points: &Bound<'py, PyAny>,
+        max_distance: f64,
+    ) -> PyResult<Bound<'py, PyTuple>> {
+        let Shape::HeightField(h) = shape_of(slf) else {
+            return Err(wrong_kind("HeightField"));
+        };
+        let md = scalar("max_distance", max_distance)?;
+        crate::mesh::closest_points_heightfield(slf.py(), h, points, md)
+    }
+
     /// Indices (ascending int64) of the triangles whose bounding boxes overlap the box
     /// `[aabb_min, aabb_max]` (heightfield frame).
     fn overlapping_triangles<'py>(

@@ -13,7 +13,7 @@ use crate::pose::extract_isometry;
 use crate::shape::PyShape;
 use crate::shapes::{init, shape_of, wrap_shape, wrong_kind};
 use carom_collision::math::{vec3_to_f64, Aabb, Real, Vec3};
-use carom_collision::midphase::MeshRayHit;
+use carom_collision::midphase::{MeshPointProjection, MeshRayHit};
 use carom_collision::shape::{HeightField, Shape, TriMesh, TriMeshOptions, NO_NEIGHBOR};
 use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray1, PyArray2};
@@ -23,8 +23,9 @@ use std::sync::Arc;
 
 /// Closest ray hits on a mesh, one row per ray: `hit` `(N,)` bool, `distance` `(N,)` along
 /// the unit direction, `point` `(N, 3)`, `normal` `(N, 3)` (the triangle's counter-clockwise
-/// face normal, not flipped towards the ray) and `triangle` `(N,)` int64; misses hold NaN
-/// and triangle -1. In the mesh's own frame.
+/// face normal, not flipped towards the ray), `triangle` `(N,)` int64 and `barycentric`
+/// `(N, 3)` (weights of the triangle's corners, in its index order); misses hold NaN and
+/// triangle -1. In the mesh's own frame.
 #[pyclass(name = "MeshRayHits", module = "carom", frozen, get_all)]
 pub struct PyMeshRayHits {
     /// `(N,)` bool: the ray hit the mesh.
@@ -37,6 +38,9 @@ pub struct PyMeshRayHits {
     normal: Py<PyArray2<f64>>,
     /// `(N,)` int64 index of the triangle hit (-1 for misses).
     triangle: Py<PyArray1<i64>>,
+    /// `(N, 3)` barycentric weights of the hit triangle's corners at the hit point
+    /// (non-negative, summing to 1; NaN for misses).
+    barycentric: Py<PyArray2<f64>>,
 }
 
 /// Rays from `(N, 3)` arrays (or `(3,)` for one ray): finite origins, non-zero finite
@@ -141,6 +145,10 @@ fn hits_out(py: Python<'_>, hits: &[Option<MeshRayHit>]) -> PyMeshRayHits {
     let nan = Vec3::splat(Real::NAN);
     let points: Vec<Vec3> = hits.iter().map(|h| h.map_or(nan, |h| h.point)).collect();
     let normals: Vec<Vec3> = hits.iter().map(|h| h.map_or(nan, |h| h.normal)).collect();
+    let bary: Vec<Vec3> = hits
+        .iter()
+        .map(|h| h.map_or(nan, |h| Vec3::from(h.barycentric)))
+        .collect();
     PyMeshRayHits {
         hit: PyArray1::from_vec(py, hits.iter().map(Option::is_some).collect()).unbind(),
         distance: PyArray1::from_vec(
@@ -159,6 +167,7 @@ fn hits_out(py: Python<'_>, hits: &[Option<MeshRayHit>]) -> PyMeshRayHits {
                 .collect(),
         )
         .unbind(),
+        barycentric: vec3s_out(py, &bary).unbind(),
     }
 }
 
@@ -170,10 +179,35 @@ pub fn closest_points<'py>(
     points: &Bound<'py, PyAny>,
     max_distance: Real,
 ) -> PyResult<Bound<'py, PyTuple>> {
+    closest_points_with(py, points, max_distance, |pts, md| {
+        mesh.closest_point_batch(pts, md)
+    })
+}
+
+/// `heightfield.closest_points(points, max_distance)`, by `HeightField::closest_point`.
+pub fn closest_points_heightfield<'py>(
+    py: Python<'py>,
+    hf: &HeightField,
+    points: &Bound<'py, PyAny>,
+    max_distance: Real,
+) -> PyResult<Bound<'py, PyTuple>> {
+    closest_points_with(py, points, max_distance, |pts, md| {
+        batch::map(pts, |p| hf.closest_point(*p, md))
+    })
+}
+
+/// Batch closest points with `query(points, max_distance)` (GIL released) as the
+/// `(points, distances, triangles)` tuple.
+fn closest_points_with<'py>(
+    py: Python<'py>,
+    points: &Bound<'py, PyAny>,
+    max_distance: Real,
+    query: impl Fn(&[Vec3], Real) -> Vec<Option<MeshPointProjection>> + Send + Sync,
+) -> PyResult<Bound<'py, PyTuple>> {
     check_max_distance(max_distance)?;
     let (pts, _) = vec3s(points, "points", true)?;
     require_finite("points", &pts)?;
-    let res = py.detach(|| guard(|| Ok(mesh.closest_point_batch(&pts, max_distance))))?;
+    let res = py.detach(|| guard(|| Ok(query(&pts, max_distance))))?;
     let nan = Vec3::splat(Real::NAN);
     let cp: Vec<Vec3> = res.iter().map(|r| r.map_or(nan, |r| r.point)).collect();
     let dist: Vec<f64> = res

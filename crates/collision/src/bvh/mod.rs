@@ -3,7 +3,9 @@
 //! - [`Bvh`]: a static, stackless BVH with quantised 16-byte nodes (or unquantised ones),
 //!   binned-SAH build, refit, and its traversals (box, ray, point, BVH-vs-BVH). Triangle
 //!   meshes own one; the midphase's triangle queries run on it. The layout is Bullet's
-//!   `btQuantizedBvh` as presented in Coumans' SIGGRAPH 2010 talk.
+//!   `btQuantizedBvh` as presented in Coumans' SIGGRAPH 2010 talk. The quantised layout also
+//!   keeps its tree collapsed to 4-wide nodes ([`WideNode`], one cache line each) for
+//!   closest-hit rays.
 //! - [`DynamicTree`]: the incrementally updated AABB tree of Bullet's `btDbvt` and Box2D's
 //!   `b2DynamicTree`. The tree broadphase is built on it, and compound shapes keep their
 //!   children in one (Bullet's `btCompoundShape`), so children can be added, moved and removed.

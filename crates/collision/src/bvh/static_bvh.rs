@@ -132,8 +132,10 @@ pub(crate) enum Nodes {
 }
 
 /// A static BVH over primitive boxes (triangles, heightfield cells, compound children).
-/// Build with [`Bvh::new`]; query with the traversals in `bvh::traverse`.
+/// Build with [`Bvh::new`]; query with the traversals in `bvh::traverse`. Serialised without
+/// its 4-wide nodes, which are derived from the binary ones when loading.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "BvhData", into = "BvhData")]
 pub struct Bvh {
     pub(crate) nodes: Nodes,
     /// Primitive indices; a leaf covers a contiguous range.
@@ -143,6 +145,82 @@ pub struct Bvh {
     /// The quantised nodes collapsed to 4-wide nodes for closest-hit rays (`bvh::wide`);
     /// empty for the unquantised layout and when the root is a leaf.
     pub(crate) wide: Vec<WideNode>,
+}
+
+/// The serialised form of a [`Bvh`]: everything but the derived 4-wide nodes. Loading checks
+/// the tree structure (ranges and escape indices in bounds, subtrees nested), so corrupted
+/// bytes give an error rather than a panic in a traversal.
+#[derive(Serialize, Deserialize)]
+struct BvhData {
+    nodes: Nodes,
+    order: Vec<u32>,
+    bounds: Aabb,
+}
+
+impl TryFrom<BvhData> for Bvh {
+    type Error = String;
+    fn try_from(d: BvhData) -> std::result::Result<Self, String> {
+        let data: Vec<u32> = match &d.nodes {
+            Nodes::Quantized(v, _) => v.iter().map(|n| n.data).collect(),
+            Nodes::Unquantized(v) => v.iter().map(|n| n.data).collect(),
+        };
+        check_structure(&data, &d.order)?;
+        Ok(Bvh {
+            wide: wide_nodes(&d.nodes),
+            nodes: d.nodes,
+            order: d.order,
+            bounds: d.bounds,
+        })
+    }
+}
+
+/// Checks that `data` (node escape indices and leaf ranges) forms a depth-first tree over
+/// `order`, a permutation-sized list of primitive indices in range.
+fn check_structure(data: &[u32], order: &[u32]) -> std::result::Result<(), String> {
+    let n = data.len();
+    let escape = |i: usize| {
+        if data[i] & LEAF_FLAG != 0 {
+            i + 1
+        } else {
+            data[i] as usize
+        }
+    };
+    if n == 0 || order.is_empty() || escape(0) != n {
+        return Err("invalid BVH: empty, or the root does not span the nodes".into());
+    }
+    if let Some(p) = order.iter().find(|&&p| p as usize >= order.len()) {
+        return Err(format!("invalid BVH: primitive {p} out of range"));
+    }
+    for (i, &d) in data.iter().enumerate() {
+        if d & LEAF_FLAG != 0 {
+            let (first, count) = leaf_range(d);
+            if first + count > order.len() {
+                return Err(format!("invalid BVH: leaf {i} out of range"));
+            }
+        } else {
+            let e = d as usize;
+            // Left child i + 1, right child r, both inside the subtree, the right one
+            // ending where the parent does.
+            if e <= i + 2 || e > n {
+                return Err(format!("invalid BVH: escape index of node {i}"));
+            }
+            let r = escape(i + 1);
+            if r <= i + 1 || r >= e || escape(r) != e {
+                return Err(format!("invalid BVH: children of node {i}"));
+            }
+        }
+    }
+    Ok(())
+}
+
+impl From<Bvh> for BvhData {
+    fn from(b: Bvh) -> Self {
+        BvhData {
+            nodes: b.nodes,
+            order: b.order,
+            bounds: b.bounds,
+        }
+    }
 }
 
 /// Encodes a leaf's primitive range.
@@ -411,6 +489,66 @@ mod tests {
             let d = q.dequantize(q.quantize(b.min, false), q.quantize(b.max, true));
             assert!(d.contains(&b), "{d:?} must contain {b:?}");
         }
+    }
+
+    #[test]
+    fn loading_checks_the_tree_structure() {
+        let boxes: Vec<Aabb> = (0..50)
+            .map(|i| Aabb::new(Vec3::splat(i as Real), Vec3::splat(i as Real + 1.5)))
+            .collect();
+        let bvh = Bvh::new(&boxes, BvhLayout::Quantized).unwrap();
+        let back = Bvh::try_from(BvhData::from(bvh.clone())).unwrap();
+        assert_eq!(back, bvh);
+        let Nodes::Quantized(nodes, q) = &bvh.nodes else {
+            unreachable!()
+        };
+        let n = nodes.len();
+        let data: Vec<u32> = nodes.iter().map(|x| x.data).collect();
+        // Every corruption of one node's data or of the order is caught or harmless.
+        let mut caught = 0;
+        for i in 0..n {
+            for bad in [
+                0u32,
+                1,
+                i as u32 + 1,
+                n as u32 + 5,
+                LEAF_FLAG | 60,
+                u32::MAX,
+            ] {
+                let mut v = nodes.clone();
+                v[i].data = bad;
+                let d = BvhData {
+                    nodes: Nodes::Quantized(v, *q),
+                    order: bvh.order.clone(),
+                    bounds: bvh.bounds,
+                };
+                match Bvh::try_from(d) {
+                    Err(_) => caught += 1,
+                    Ok(b) => {
+                        // Accepted: a consistent tree, so the traversals run.
+                        let mut count = 0;
+                        b.for_each_candidate_in_aabb(&b.root_aabb(), |_| {
+                            count += 1;
+                            true
+                        });
+                        b.for_each_candidate_on_ray_ordered(Vec3::ZERO, Vec3::ONE, 1e3, |_, _| {
+                            true
+                        });
+                        assert!(count <= 8 * n);
+                    }
+                }
+            }
+        }
+        assert!(caught > n, "{caught} of {} corruptions caught", 6 * n);
+        assert!(data.iter().any(|d| d & LEAF_FLAG == 0));
+        let mut order = bvh.order.clone();
+        order[3] = 50;
+        let d = BvhData {
+            nodes: bvh.nodes.clone(),
+            order,
+            bounds: bvh.bounds,
+        };
+        assert!(Bvh::try_from(d).is_err());
     }
 
     #[test]

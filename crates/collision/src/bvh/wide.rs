@@ -22,14 +22,13 @@
 use super::static_bvh::{leaf_range, right_child, QuantizedNode, LEAF_FLAG};
 use super::traverse::{RayStack, ROBUST_EXIT};
 use crate::math::{Real, Vec3};
-use serde::{Deserialize, Serialize};
 
 /// Marker of an unused child slot.
 const EMPTY: u32 = u32::MAX;
 
 /// Four child boxes and references in one cache line.
 #[repr(C, align(64))]
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct WideNode {
     /// Quantised child boxes plane by plane: min x, min y, min z, max x, max y, max z; lane
     /// `k` is child `k`. Unused lanes hold an inverted box.
