@@ -26,21 +26,26 @@ pub(crate) struct Colouring {
     pub ranges: Vec<Range<usize>>,
 }
 
-/// Colours `pairs` (body slots of each constraint); `dynamic[i]` tells whether body `i` is
-/// written by the solver.
-pub(crate) fn colour(pairs: &[(usize, usize)], dynamic: &[bool]) -> Colouring {
-    let mut used = vec![0u32; dynamic.len()];
+/// Colours `pairs` (body slots of each constraint, below `body_count`); `dynamic(i)` tells
+/// whether body `i` is written by the solver.
+pub(crate) fn colour(
+    pairs: &[(usize, usize)],
+    body_count: usize,
+    dynamic: impl Fn(usize) -> bool,
+) -> Colouring {
+    let mut used = vec![0u32; body_count];
     let mut colour_of = Vec::with_capacity(pairs.len());
     let mut counts = [0usize; COLOURS + 1];
     for &(a, b) in pairs {
-        let mask = (if dynamic[a] { used[a] } else { 0 }) | (if dynamic[b] { used[b] } else { 0 });
+        let (da, db) = (dynamic(a), dynamic(b));
+        let mask = (if da { used[a] } else { 0 }) | (if db { used[b] } else { 0 });
         let c = (!mask).trailing_zeros() as usize;
         let c = if c < COLOURS { c } else { COLOURS };
         if c < COLOURS {
-            if dynamic[a] {
+            if da {
                 used[a] |= 1 << c;
             }
-            if dynamic[b] {
+            if db {
                 used[b] |= 1 << c;
             }
         }
@@ -194,7 +199,7 @@ mod tests {
             (4, 0),
         ];
         let dynamic = [true, true, true, true, true, false];
-        let c = colour(&pairs, &dynamic);
+        let c = colour(&pairs, dynamic.len(), |i| dynamic[i]);
         let mut seen: Vec<usize> = c.order.clone();
         seen.sort_unstable();
         assert_eq!(seen, (0..pairs.len()).collect::<Vec<_>>());

@@ -7,11 +7,12 @@
 //! `btSequentialImpulseConstraintSolver::setupContactConstraint`). The anchor of a point is
 //! the midpoint of its two witness points, as in Box2D.
 
-use super::coloring::PairConstraint;
+use super::coloring::{colour, PairConstraint};
 use super::{inv_or_zero, Softness, SolverBody, SolverParams};
 use crate::body_set::BodySet;
 use crate::contact::{ContactManifold, MAX_MANIFOLD_POINTS};
 use carom_collision::math::{orthonormal_basis, Real, Vec3};
+use std::ops::Range;
 
 /// One Jacobian row of a contact point along a unit direction `d` (the normal or a tangent):
 /// the angular parts `r_a × d`, `r_b × d` and the same premultiplied by the inverse world
@@ -113,8 +114,11 @@ impl PairConstraint for ContactConstraint {
     }
 }
 
-/// Builds the constraints of the manifolds that touch an awake dynamic body. `impulse_in`
-/// scales the stored impulses (per-step units) to the solver's units (0 disables warm start).
+/// Builds the constraints of the manifolds that touch an awake dynamic body, already in
+/// colour order (module `coloring`), and returns them with the colour ranges. `impulse_in`
+/// scales the stored impulses (per-step units) to the solver's units (0 disables warm
+/// start). The manifolds are coloured first and each constraint is built once, at its
+/// place: no reordering copy of the (large) constraints.
 pub(crate) fn prepare(
     manifolds: &[ContactManifold],
     set: &BodySet,
@@ -122,64 +126,98 @@ pub(crate) fn prepare(
     impulse_in: Real,
     soft: Softness,
     static_soft: Softness,
-) -> Vec<ContactConstraint> {
-    let mut out = Vec::with_capacity(manifolds.len());
+) -> (Vec<ContactConstraint>, Vec<Range<usize>>) {
+    let mut selected = Vec::with_capacity(manifolds.len());
+    let mut pairs = Vec::with_capacity(manifolds.len());
     for (m_index, m) in manifolds.iter().enumerate() {
         let (a, b) = (m.body_a.index as usize, m.body_b.index as usize);
         if m.points().is_empty() || !(bodies[a].dynamic || bodies[b].dynamic) {
             continue;
         }
-        let (ba, bb) = (&bodies[a], &bodies[b]);
-        let (pose_a, pose_b) = (set.pose_of(a), set.pose_of(b));
-        let (com_a, com_b) = (set.position[a], set.position[b]);
-        let n = m.normal.normalize();
-        let mut points = [PointConstraint::default(); MAX_MANIFOLD_POINTS];
-        let mut arms = [(Vec3::ZERO, Vec3::ZERO); MAX_MANIFOLD_POINTS];
-        let mut centre_velocity = Vec3::ZERO;
-        for (k, p) in m.points().iter().enumerate() {
-            let c = 0.5 * (pose_a.transform_point(p.local_a) + pose_b.transform_point(p.local_b));
-            let (ra, rb) = (c - com_a, c - com_b);
-            arms[k] = (ra, rb);
-            let dv = bb.point_velocity(rb) - ba.point_velocity(ra);
-            centre_velocity += dv;
-            points[k] = PointConstraint {
-                normal_row: ContactRow::new(ba, bb, ra, rb, n),
-                separation: p.separation,
-                relative_velocity: dv.dot(n),
-                normal_impulse: p.normal_impulse * impulse_in,
-                tangent_impulse: [
-                    p.tangent_impulse[0] * impulse_in,
-                    p.tangent_impulse[1] * impulse_in,
-                ],
-                ..Default::default()
-            };
-        }
-        let t1 = friction_direction(m.tangent, n, centre_velocity / m.points().len() as Real);
-        let t2 = n.cross(t1);
-        for (pt, &(ra, rb)) in points.iter_mut().zip(&arms).take(m.points().len()) {
-            pt.tangent_rows = [
-                ContactRow::new(ba, bb, ra, rb, t1),
-                ContactRow::new(ba, bb, ra, rb, t2),
-            ];
-        }
-        out.push(ContactConstraint {
-            a,
-            b,
-            manifold: m_index,
-            normal: n,
-            tangent: [t1, t2],
-            friction: m.friction,
-            restitution: m.restitution,
-            softness: if ba.dynamic && bb.dynamic {
-                soft
-            } else {
-                static_soft
-            },
-            points,
-            len: m.points().len(),
-        });
+        selected.push(m_index);
+        pairs.push((a, b));
     }
-    out
+    let col = colour(&pairs, bodies.len(), |i| bodies[i].dynamic);
+    let cons = col
+        .order
+        .iter()
+        .map(|&k| {
+            let m_index = selected[k];
+            prepare_one(
+                &manifolds[m_index],
+                m_index,
+                set,
+                bodies,
+                impulse_in,
+                soft,
+                static_soft,
+            )
+        })
+        .collect();
+    (cons, col.ranges)
+}
+
+/// The constraint of manifold `m` (index `m_index`), which touches an awake dynamic body.
+#[allow(clippy::too_many_arguments)]
+fn prepare_one(
+    m: &ContactManifold,
+    m_index: usize,
+    set: &BodySet,
+    bodies: &[SolverBody],
+    impulse_in: Real,
+    soft: Softness,
+    static_soft: Softness,
+) -> ContactConstraint {
+    let (a, b) = (m.body_a.index as usize, m.body_b.index as usize);
+    let (ba, bb) = (&bodies[a], &bodies[b]);
+    let (pose_a, pose_b) = (set.pose_of(a), set.pose_of(b));
+    let (com_a, com_b) = (set.position[a], set.position[b]);
+    let n = m.normal.normalize();
+    let mut points = [PointConstraint::default(); MAX_MANIFOLD_POINTS];
+    let mut arms = [(Vec3::ZERO, Vec3::ZERO); MAX_MANIFOLD_POINTS];
+    let mut centre_velocity = Vec3::ZERO;
+    for (k, p) in m.points().iter().enumerate() {
+        let c = 0.5 * (pose_a.transform_point(p.local_a) + pose_b.transform_point(p.local_b));
+        let (ra, rb) = (c - com_a, c - com_b);
+        arms[k] = (ra, rb);
+        let dv = bb.point_velocity(rb) - ba.point_velocity(ra);
+        centre_velocity += dv;
+        points[k] = PointConstraint {
+            normal_row: ContactRow::new(ba, bb, ra, rb, n),
+            separation: p.separation,
+            relative_velocity: dv.dot(n),
+            normal_impulse: p.normal_impulse * impulse_in,
+            tangent_impulse: [
+                p.tangent_impulse[0] * impulse_in,
+                p.tangent_impulse[1] * impulse_in,
+            ],
+            ..Default::default()
+        };
+    }
+    let t1 = friction_direction(m.tangent, n, centre_velocity / m.points().len() as Real);
+    let t2 = n.cross(t1);
+    for (pt, &(ra, rb)) in points.iter_mut().zip(&arms).take(m.points().len()) {
+        pt.tangent_rows = [
+            ContactRow::new(ba, bb, ra, rb, t1),
+            ContactRow::new(ba, bb, ra, rb, t2),
+        ];
+    }
+    ContactConstraint {
+        a,
+        b,
+        manifold: m_index,
+        normal: n,
+        tangent: [t1, t2],
+        friction: m.friction,
+        restitution: m.restitution,
+        softness: if ba.dynamic && bb.dynamic {
+            soft
+        } else {
+            static_soft
+        },
+        points,
+        len: m.points().len(),
+    }
 }
 
 /// The first friction direction: the cached one if still roughly in the tangent plane
