@@ -8,7 +8,7 @@
 //! boxes, 2 m cubes of 2 kg dropped with the scene's spacing and shift), measured with the
 //! exact box–box query, not with the manifolds the solver saw.
 mod pipeline;
-use carom_dynamics::collision::math::{Isometry, Quat, Real, Vec3};
+use carom_dynamics::collision::math::{Isometry, Real, Vec3};
 use carom_dynamics::collision::query;
 use carom_dynamics::collision::shape::{Cuboid, Shape};
 use carom_dynamics::*;

@@ -26,21 +26,26 @@ pub(crate) struct Colouring {
     pub ranges: Vec<Range<usize>>,
 }
 
-/// Colours `pairs` (body slots of each constraint); `dynamic[i]` tells whether body `i` is
-/// written by the solver.
-pub(crate) fn colour(pairs: &[(usize, usize)], dynamic: &[bool]) -> Colouring {
-    let mut used = vec![0u32; dynamic.len()];
+/// Colours `pairs` (body slots of each constraint, below `body_count`); `dynamic(i)` tells
+/// whether body `i` is written by the solver.
+pub(crate) fn colour(
+    pairs: &[(usize, usize)],
+    body_count: usize,
+    dynamic: impl Fn(usize) -> bool,
+) -> Colouring {
+    let mut used = vec![0u32; body_count];
     let mut colour_of = Vec::with_capacity(pairs.len());
     let mut counts = [0usize; COLOURS + 1];
     for &(a, b) in pairs {
-        let mask = (if dynamic[a] { used[a] } else { 0 }) | (if dynamic[b] { used[b] } else { 0 });
+        let (da, db) = (dynamic(a), dynamic(b));
+        let mask = (if da { used[a] } else { 0 }) | (if db { used[b] } else { 0 });
         let c = (!mask).trailing_zeros() as usize;
         let c = if c < COLOURS { c } else { COLOURS };
         if c < COLOURS {
-            if dynamic[a] {
+            if da {
                 used[a] |= 1 << c;
             }
-            if dynamic[b] {
+            if db {
                 used[b] |= 1 << c;
             }
         }
@@ -65,9 +70,12 @@ pub(crate) fn colour(pairs: &[(usize, usize)], dynamic: &[bool]) -> Colouring {
 }
 
 /// Runs `f` on every constraint, colour by colour. Inside a colour, constraints run in
-/// parallel when `parallel` and the colour holds at least `min_batch` constraints; each call
-/// works on copies of its two bodies that are written back afterwards, so the result is the
-/// same bits as the sequential loop. The overflow colour always runs sequentially.
+/// parallel when `parallel`, the colour holds at least `min_batch` constraints and rayon has
+/// more than one thread. Every call works in place on its two bodies: a colour's constraints
+/// share no dynamic body, so they write disjoint bodies, and a static or kinematic body
+/// (shared, never written) is handed over as a copy. The result is the same bits as the
+/// sequential loop, whatever the thread count. The overflow colour always runs
+/// sequentially. No allocation.
 pub(crate) fn solve_coloured<C, F>(
     cons: &mut [C],
     ranges: &[Range<usize>],
@@ -86,22 +94,65 @@ pub(crate) fn solve_coloured<C, F>(
         if go_parallel && solve_parallel(chunk, bodies, &f) {
             continue;
         }
+        let shared = SharedBodies::new(bodies);
         for c in chunk.iter_mut() {
-            let (ia, ib) = c.bodies();
-            let (mut a, mut b) = (bodies[ia], bodies[ib]);
-            f(c, &mut a, &mut b);
-            write_back(bodies, ia, a, ib, b);
+            // SAFETY: `shared` is the only access to `bodies` in this loop and the
+            // constraints run one at a time.
+            unsafe { shared.with_pair(c, &f) };
         }
     }
 }
 
-#[inline]
-fn write_back(bodies: &mut [SolverBody], ia: usize, a: SolverBody, ib: usize, b: SolverBody) {
-    if a.dynamic {
-        bodies[ia] = a;
+/// Raw access to the solver bodies for the constraints of one colour.
+#[derive(Clone, Copy)]
+struct SharedBodies {
+    ptr: *mut SolverBody,
+    len: usize,
+}
+
+// SAFETY: used only to solve the constraints of one colour, which write disjoint dynamic
+// bodies (the colouring guarantees it) and never write non-dynamic ones.
+unsafe impl Send for SharedBodies {}
+unsafe impl Sync for SharedBodies {}
+
+impl SharedBodies {
+    fn new(bodies: &mut [SolverBody]) -> Self {
+        SharedBodies {
+            ptr: bodies.as_mut_ptr(),
+            len: bodies.len(),
+        }
     }
-    if b.dynamic {
-        bodies[ib] = b;
+
+    /// Runs `f` on constraint `c` with mutable access to its dynamic bodies in place and
+    /// copies of its non-dynamic ones.
+    ///
+    /// # Safety
+    /// No other live reference may touch the dynamic bodies of `c` during the call: the
+    /// caller runs only constraints of one colour concurrently.
+    #[inline(always)]
+    unsafe fn with_pair<C, F>(self, c: &mut C, f: &F)
+    where
+        C: PairConstraint,
+        F: Fn(&mut C, &mut SolverBody, &mut SolverBody),
+    {
+        let (ia, ib) = c.bodies();
+        assert!(ia < self.len && ib < self.len);
+        debug_assert_ne!(ia, ib);
+        let (pa, pb) = (self.ptr.add(ia), self.ptr.add(ib));
+        let (mut ca, mut cb);
+        let a: &mut SolverBody = if (*pa).dynamic {
+            &mut *pa
+        } else {
+            ca = *pa;
+            &mut ca
+        };
+        let b: &mut SolverBody = if (*pb).dynamic {
+            &mut *pb
+        } else {
+            cb = *pb;
+            &mut cb
+        };
+        f(c, a, b);
     }
 }
 
@@ -112,19 +163,16 @@ where
     F: Fn(&mut C, &mut SolverBody, &mut SolverBody) + Sync,
 {
     use rayon::prelude::*;
-    let shared: &[SolverBody] = bodies;
-    let results: Vec<(usize, SolverBody, usize, SolverBody)> = chunk
-        .par_iter_mut()
-        .map(|c| {
-            let (ia, ib) = c.bodies();
-            let (mut a, mut b) = (shared[ia], shared[ib]);
-            f(c, &mut a, &mut b);
-            (ia, a, ib, b)
-        })
-        .collect();
-    for (ia, a, ib, b) in results {
-        write_back(bodies, ia, a, ib, b);
+    if rayon::current_num_threads() < 2 {
+        return false;
     }
+    let shared = SharedBodies::new(bodies);
+    // SAFETY: the constraints of one colour share no dynamic body (see `colour`), so the
+    // parallel calls write disjoint bodies; non-dynamic bodies are only read (copied).
+    chunk
+        .par_iter_mut()
+        .with_min_len(64)
+        .for_each(|c| unsafe { shared.with_pair(c, f) });
     true
 }
 
@@ -151,7 +199,7 @@ mod tests {
             (4, 0),
         ];
         let dynamic = [true, true, true, true, true, false];
-        let c = colour(&pairs, &dynamic);
+        let c = colour(&pairs, dynamic.len(), |i| dynamic[i]);
         let mut seen: Vec<usize> = c.order.clone();
         seen.sort_unstable();
         assert_eq!(seen, (0..pairs.len()).collect::<Vec<_>>());

@@ -7,19 +7,83 @@
 //! `btSequentialImpulseConstraintSolver::setupContactConstraint`). The anchor of a point is
 //! the midpoint of its two witness points, as in Box2D.
 
-use super::coloring::PairConstraint;
+use super::coloring::{colour, PairConstraint};
 use super::{inv_or_zero, Softness, SolverBody, SolverParams};
 use crate::body_set::BodySet;
 use crate::contact::{ContactManifold, MAX_MANIFOLD_POINTS};
 use carom_collision::math::{orthonormal_basis, Real, Vec3};
+use std::ops::Range;
+
+/// One Jacobian row of a contact point along a unit direction `d` (the normal or a tangent):
+/// the angular parts `r_a × d`, `r_b × d` and the same premultiplied by the inverse world
+/// inertias, so a solve is dot products and scaled adds only (no matrix product, no cross
+/// product in the iteration loop; Box2D's and Rapier's contact solvers store the same).
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct ContactRow {
+    /// `r_a × d`.
+    pub ang_a: Vec3,
+    /// `r_b × d`.
+    pub ang_b: Vec3,
+    /// `I_a⁻¹ (r_a × d)`: change of A's angular velocity per unit impulse (negated).
+    pub inv_ang_a: Vec3,
+    /// `I_b⁻¹ (r_b × d)`: change of B's angular velocity per unit impulse.
+    pub inv_ang_b: Vec3,
+    /// Effective mass `1 / (J M⁻¹ Jᵀ)`.
+    pub mass: Real,
+}
+
+impl ContactRow {
+    fn new(a: &SolverBody, b: &SolverBody, ra: Vec3, rb: Vec3, d: Vec3) -> ContactRow {
+        let (ang_a, ang_b) = (ra.cross(d), rb.cross(d));
+        let (inv_ang_a, inv_ang_b) = (a.inv_i * ang_a, b.inv_i * ang_b);
+        let k = a.inv_m + b.inv_m + ang_a.dot(inv_ang_a) + ang_b.dot(inv_ang_b);
+        ContactRow {
+            ang_a,
+            ang_b,
+            inv_ang_a,
+            inv_ang_b,
+            mass: inv_or_zero(k),
+        }
+    }
+
+    /// Relative velocity of B with respect to A along the row (`J v`).
+    #[inline(always)]
+    fn velocity(&self, d: Vec3, a: &SolverBody, b: &SolverBody) -> Real {
+        d.dot(b.v - a.v) + self.ang_b.dot(b.w) - self.ang_a.dot(a.w)
+    }
+
+    /// Relative displacement along the row from the position deltas (`J Δx`).
+    #[inline(always)]
+    fn displacement(&self, d: Vec3, a: &SolverBody, b: &SolverBody) -> Real {
+        d.dot(b.dp - a.dp) + self.ang_b.dot(b.dq) - self.ang_a.dot(a.dq)
+    }
+
+    /// Applies impulse `lambda` along the row: `-λ` to A, `+λ` to B.
+    #[inline(always)]
+    fn apply(&self, d: Vec3, lambda: Real, a: &mut SolverBody, b: &mut SolverBody) {
+        a.v -= d * (lambda * a.inv_m);
+        a.w -= self.inv_ang_a * lambda;
+        b.v += d * (lambda * b.inv_m);
+        b.w += self.inv_ang_b * lambda;
+    }
+
+    /// Applies impulse `lambda` to the pseudo-velocities (split impulses).
+    #[inline(always)]
+    fn apply_push(&self, d: Vec3, lambda: Real, a: &mut SolverBody, b: &mut SolverBody) {
+        a.dp -= d * (lambda * a.inv_m);
+        a.dq -= self.inv_ang_a * lambda;
+        b.dp += d * (lambda * b.inv_m);
+        b.dq += self.inv_ang_b * lambda;
+    }
+}
 
 /// One prepared contact point.
 #[derive(Debug, Clone, Copy, Default)]
 pub(crate) struct PointConstraint {
-    pub ra: Vec3,
-    pub rb: Vec3,
-    pub normal_mass: Real,
-    pub tangent_mass: [Real; 2],
+    /// The normal row.
+    pub normal_row: ContactRow,
+    /// The two friction rows (along the constraint's tangents).
+    pub tangent_rows: [ContactRow; 2],
     pub separation: Real,
     /// Normal relative velocity at preparation (for restitution).
     pub relative_velocity: Real,
@@ -50,23 +114,11 @@ impl PairConstraint for ContactConstraint {
     }
 }
 
-/// `1 / (J M⁻¹ Jᵀ)` for an impulse along `dir` at lever arms `ra`, `rb`.
-#[inline]
-pub(crate) fn effective_mass(
-    a: &SolverBody,
-    b: &SolverBody,
-    ra: Vec3,
-    rb: Vec3,
-    dir: Vec3,
-) -> Real {
-    let rna = ra.cross(dir);
-    let rnb = rb.cross(dir);
-    let k = a.inv_m + b.inv_m + rna.dot(a.inv_i * rna) + rnb.dot(b.inv_i * rnb);
-    inv_or_zero(k)
-}
-
-/// Builds the constraints of the manifolds that touch an awake dynamic body. `impulse_in`
-/// scales the stored impulses (per-step units) to the solver's units (0 disables warm start).
+/// Builds the constraints of the manifolds that touch an awake dynamic body, already in
+/// colour order (module `coloring`), and returns them with the colour ranges. `impulse_in`
+/// scales the stored impulses (per-step units) to the solver's units (0 disables warm
+/// start). The manifolds are coloured first and each constraint is built once, at its
+/// place: no reordering copy of the (large) constraints.
 pub(crate) fn prepare(
     manifolds: &[ContactManifold],
     set: &BodySet,
@@ -74,64 +126,98 @@ pub(crate) fn prepare(
     impulse_in: Real,
     soft: Softness,
     static_soft: Softness,
-) -> Vec<ContactConstraint> {
-    let mut out = Vec::with_capacity(manifolds.len());
+) -> (Vec<ContactConstraint>, Vec<Range<usize>>) {
+    let mut selected = Vec::with_capacity(manifolds.len());
+    let mut pairs = Vec::with_capacity(manifolds.len());
     for (m_index, m) in manifolds.iter().enumerate() {
         let (a, b) = (m.body_a.index as usize, m.body_b.index as usize);
         if m.points().is_empty() || !(bodies[a].dynamic || bodies[b].dynamic) {
             continue;
         }
-        let (ba, bb) = (&bodies[a], &bodies[b]);
-        let (pose_a, pose_b) = (set.pose_of(a), set.pose_of(b));
-        let (com_a, com_b) = (set.position[a], set.position[b]);
-        let n = m.normal.normalize();
-        let mut points = [PointConstraint::default(); MAX_MANIFOLD_POINTS];
-        let mut centre_velocity = Vec3::ZERO;
-        for (k, p) in m.points().iter().enumerate() {
-            let c = 0.5 * (pose_a.transform_point(p.local_a) + pose_b.transform_point(p.local_b));
-            let (ra, rb) = (c - com_a, c - com_b);
-            let dv = bb.point_velocity(rb) - ba.point_velocity(ra);
-            centre_velocity += dv;
-            points[k] = PointConstraint {
-                ra,
-                rb,
-                normal_mass: effective_mass(ba, bb, ra, rb, n),
-                separation: p.separation,
-                relative_velocity: dv.dot(n),
-                normal_impulse: p.normal_impulse * impulse_in,
-                tangent_impulse: [
-                    p.tangent_impulse[0] * impulse_in,
-                    p.tangent_impulse[1] * impulse_in,
-                ],
-                ..Default::default()
-            };
-        }
-        let t1 = friction_direction(m.tangent, n, centre_velocity / m.points().len() as Real);
-        let t2 = n.cross(t1);
-        for pt in points.iter_mut().take(m.points().len()) {
-            pt.tangent_mass = [
-                effective_mass(ba, bb, pt.ra, pt.rb, t1),
-                effective_mass(ba, bb, pt.ra, pt.rb, t2),
-            ];
-        }
-        out.push(ContactConstraint {
-            a,
-            b,
-            manifold: m_index,
-            normal: n,
-            tangent: [t1, t2],
-            friction: m.friction,
-            restitution: m.restitution,
-            softness: if ba.dynamic && bb.dynamic {
-                soft
-            } else {
-                static_soft
-            },
-            points,
-            len: m.points().len(),
-        });
+        selected.push(m_index);
+        pairs.push((a, b));
     }
-    out
+    let col = colour(&pairs, bodies.len(), |i| bodies[i].dynamic);
+    let cons = col
+        .order
+        .iter()
+        .map(|&k| {
+            let m_index = selected[k];
+            prepare_one(
+                &manifolds[m_index],
+                m_index,
+                set,
+                bodies,
+                impulse_in,
+                soft,
+                static_soft,
+            )
+        })
+        .collect();
+    (cons, col.ranges)
+}
+
+/// The constraint of manifold `m` (index `m_index`), which touches an awake dynamic body.
+#[allow(clippy::too_many_arguments)]
+fn prepare_one(
+    m: &ContactManifold,
+    m_index: usize,
+    set: &BodySet,
+    bodies: &[SolverBody],
+    impulse_in: Real,
+    soft: Softness,
+    static_soft: Softness,
+) -> ContactConstraint {
+    let (a, b) = (m.body_a.index as usize, m.body_b.index as usize);
+    let (ba, bb) = (&bodies[a], &bodies[b]);
+    let (pose_a, pose_b) = (set.pose_of(a), set.pose_of(b));
+    let (com_a, com_b) = (set.position[a], set.position[b]);
+    let n = m.normal.normalize();
+    let mut points = [PointConstraint::default(); MAX_MANIFOLD_POINTS];
+    let mut arms = [(Vec3::ZERO, Vec3::ZERO); MAX_MANIFOLD_POINTS];
+    let mut centre_velocity = Vec3::ZERO;
+    for (k, p) in m.points().iter().enumerate() {
+        let c = 0.5 * (pose_a.transform_point(p.local_a) + pose_b.transform_point(p.local_b));
+        let (ra, rb) = (c - com_a, c - com_b);
+        arms[k] = (ra, rb);
+        let dv = bb.point_velocity(rb) - ba.point_velocity(ra);
+        centre_velocity += dv;
+        points[k] = PointConstraint {
+            normal_row: ContactRow::new(ba, bb, ra, rb, n),
+            separation: p.separation,
+            relative_velocity: dv.dot(n),
+            normal_impulse: p.normal_impulse * impulse_in,
+            tangent_impulse: [
+                p.tangent_impulse[0] * impulse_in,
+                p.tangent_impulse[1] * impulse_in,
+            ],
+            ..Default::default()
+        };
+    }
+    let t1 = friction_direction(m.tangent, n, centre_velocity / m.points().len() as Real);
+    let t2 = n.cross(t1);
+    for (pt, &(ra, rb)) in points.iter_mut().zip(&arms).take(m.points().len()) {
+        pt.tangent_rows = [
+            ContactRow::new(ba, bb, ra, rb, t1),
+            ContactRow::new(ba, bb, ra, rb, t2),
+        ];
+    }
+    ContactConstraint {
+        a,
+        b,
+        manifold: m_index,
+        normal: n,
+        tangent: [t1, t2],
+        friction: m.friction,
+        restitution: m.restitution,
+        softness: if ba.dynamic && bb.dynamic {
+            soft
+        } else {
+            static_soft
+        },
+        points,
+        len: m.points().len(),
+    }
 }
 
 /// The first friction direction: the cached one if still roughly in the tangent plane
@@ -155,20 +241,28 @@ pub(crate) fn warm_start(c: &mut ContactConstraint, a: &mut SolverBody, b: &mut 
         let imp = c.normal * p.normal_impulse
             + c.tangent[0] * p.tangent_impulse[0]
             + c.tangent[1] * p.tangent_impulse[1];
-        a.apply(-imp, p.ra);
-        b.apply(imp, p.rb);
+        let (t0, t1) = (&p.tangent_rows[0], &p.tangent_rows[1]);
+        a.v -= imp * a.inv_m;
+        a.w -= p.normal_row.inv_ang_a * p.normal_impulse
+            + t0.inv_ang_a * p.tangent_impulse[0]
+            + t1.inv_ang_a * p.tangent_impulse[1];
+        b.v += imp * b.inv_m;
+        b.w += p.normal_row.inv_ang_b * p.normal_impulse
+            + t0.inv_ang_b * p.tangent_impulse[0]
+            + t1.inv_ang_b * p.tangent_impulse[1];
     }
 }
 
 /// Coulomb friction on both tangent directions, clamped to the cone `μ λ_n`.
 #[inline]
 fn solve_friction(c: &mut ContactConstraint, a: &mut SolverBody, b: &mut SolverBody) {
+    let (t0, t1) = (c.tangent[0], c.tangent[1]);
     for p in c.points[..c.len].iter_mut() {
-        let dv = b.point_velocity(p.rb) - a.point_velocity(p.ra);
+        let [r0, r1] = &p.tangent_rows;
         let old = p.tangent_impulse;
         let mut new = [
-            old[0] - p.tangent_mass[0] * dv.dot(c.tangent[0]),
-            old[1] - p.tangent_mass[1] * dv.dot(c.tangent[1]),
+            old[0] - r0.mass * r0.velocity(t0, a, b),
+            old[1] - r1.mass * r1.velocity(t1, a, b),
         ];
         let max = c.friction * p.normal_impulse;
         let len_sq = new[0] * new[0] + new[1] * new[1];
@@ -177,9 +271,8 @@ fn solve_friction(c: &mut ContactConstraint, a: &mut SolverBody, b: &mut SolverB
             new = [new[0] * s, new[1] * s];
         }
         p.tangent_impulse = new;
-        let imp = c.tangent[0] * (new[0] - old[0]) + c.tangent[1] * (new[1] - old[1]);
-        a.apply(-imp, p.ra);
-        b.apply(imp, p.rb);
+        r0.apply(t0, new[0] - old[0], a, b);
+        r1.apply(t1, new[1] - old[1], a, b);
     }
 }
 
@@ -204,12 +297,11 @@ pub(crate) fn solve_velocity_si(
         } else {
             -p.separation.max(0.0) / dt
         };
-        let vn = (b.point_velocity(p.rb) - a.point_velocity(p.ra)).dot(c.normal);
-        let new = (p.normal_impulse - p.normal_mass * (vn - target)).max(0.0);
-        let imp = c.normal * (new - p.normal_impulse);
+        let row = &p.normal_row;
+        let vn = row.velocity(c.normal, a, b);
+        let new = (p.normal_impulse - row.mass * (vn - target)).max(0.0);
+        row.apply(c.normal, new - p.normal_impulse, a, b);
         p.normal_impulse = new;
-        a.apply(-imp, p.ra);
-        b.apply(imp, p.rb);
     }
 }
 
@@ -228,12 +320,11 @@ pub(crate) fn solve_push_si(
         if target <= 0.0 && p.push_impulse == 0.0 {
             continue;
         }
-        let vn = ((b.dp + b.dq.cross(p.rb)) - (a.dp + a.dq.cross(p.ra))).dot(c.normal);
-        let new = (p.push_impulse + p.normal_mass * (target - vn)).max(0.0);
-        let imp = c.normal * (new - p.push_impulse);
+        let row = &p.normal_row;
+        let vn = row.displacement(c.normal, a, b);
+        let new = (p.push_impulse + row.mass * (target - vn)).max(0.0);
+        row.apply_push(c.normal, new - p.push_impulse, a, b);
         p.push_impulse = new;
-        a.apply_push(-imp, p.ra);
-        b.apply_push(imp, p.rb);
     }
 }
 
@@ -251,8 +342,8 @@ pub(crate) fn solve_soft(
 ) {
     solve_friction(c, a, b);
     for p in c.points[..c.len].iter_mut() {
-        let d = (b.dp - a.dp) + (b.dq.cross(p.rb) - a.dq.cross(p.ra));
-        let s = p.separation + d.dot(c.normal);
+        let row = &p.normal_row;
+        let s = p.separation + row.displacement(c.normal, a, b);
         let (bias, mass_scale, impulse_scale) = if s > 0.0 {
             (s * inv_h, 1.0, 0.0)
         } else if use_bias {
@@ -265,14 +356,12 @@ pub(crate) fn solve_soft(
         } else {
             (0.0, 1.0, 0.0)
         };
-        let vn = (b.point_velocity(p.rb) - a.point_velocity(p.ra)).dot(c.normal);
-        let lambda = -p.normal_mass * mass_scale * (vn + bias) - impulse_scale * p.normal_impulse;
+        let vn = row.velocity(c.normal, a, b);
+        let lambda = -row.mass * mass_scale * (vn + bias) - impulse_scale * p.normal_impulse;
         let new = (p.normal_impulse + lambda).max(0.0);
-        let imp = c.normal * (new - p.normal_impulse);
+        row.apply(c.normal, new - p.normal_impulse, a, b);
         p.normal_impulse = new;
         p.max_normal_impulse = p.max_normal_impulse.max(new);
-        a.apply(-imp, p.ra);
-        b.apply(imp, p.rb);
     }
 }
 
@@ -291,13 +380,12 @@ pub(crate) fn apply_restitution(
         if p.relative_velocity > -threshold || p.max_normal_impulse == 0.0 {
             continue;
         }
-        let vn = (b.point_velocity(p.rb) - a.point_velocity(p.ra)).dot(c.normal);
-        let lambda = -p.normal_mass * (vn + c.restitution * p.relative_velocity);
+        let row = &p.normal_row;
+        let vn = row.velocity(c.normal, a, b);
+        let lambda = -row.mass * (vn + c.restitution * p.relative_velocity);
         let new = (p.normal_impulse + lambda).max(0.0);
-        let imp = c.normal * (new - p.normal_impulse);
+        row.apply(c.normal, new - p.normal_impulse, a, b);
         p.normal_impulse = new;
-        a.apply(-imp, p.ra);
-        b.apply(imp, p.rb);
     }
 }
 

@@ -164,20 +164,6 @@ pub(crate) struct SolverBody {
 }
 
 impl SolverBody {
-    /// Applies an impulse `p` at lever arm `r` to the velocities.
-    #[inline]
-    pub fn apply(&mut self, p: Vec3, r: Vec3) {
-        self.v += p * self.inv_m;
-        self.w += self.inv_i * r.cross(p);
-    }
-
-    /// Applies an impulse to the pseudo-velocities (`dp`, `dq`).
-    #[inline]
-    pub fn apply_push(&mut self, p: Vec3, r: Vec3) {
-        self.dp += p * self.inv_m;
-        self.dq += self.inv_i * r.cross(p);
-    }
-
     /// Velocity of the material point at lever arm `r`.
     #[inline]
     pub fn point_velocity(&self, r: Vec3) -> Vec3 {

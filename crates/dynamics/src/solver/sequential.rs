@@ -6,7 +6,7 @@
 //! iterations on pseudo-velocities, and integration with `v + v_push`; the pseudo-velocities
 //! are then dropped, so resolving penetration never adds kinetic energy.
 
-use super::coloring::{colour, solve_coloured};
+use super::coloring::solve_coloured;
 use super::timing::lap;
 use super::{contact, joints, Softness, StepContext};
 use crate::integrate;
@@ -22,7 +22,7 @@ pub(crate) fn step(ctx: &mut StepContext) {
     lap(&mut t, &mut ctx.timings.forces);
 
     let warm = if p.warm_starting { 1.0 } else { 0.0 };
-    let cons = contact::prepare(
+    let (mut cons, ranges) = contact::prepare(
         ctx.manifolds,
         ctx.set,
         ctx.bodies,
@@ -31,11 +31,6 @@ pub(crate) fn step(ctx: &mut StepContext) {
         Softness::RIGID,
     );
     let mut rows = joints::build_all(ctx.joints, ctx.set, ctx.bodies, dt, warm);
-    let dynamic: Vec<bool> = ctx.bodies.iter().map(|b| b.dynamic).collect();
-    let pairs: Vec<(usize, usize)> = cons.iter().map(|c| (c.a, c.b)).collect();
-    let col = colour(&pairs, &dynamic);
-    let mut cons: Vec<_> = col.order.iter().map(|&k| cons[k].clone()).collect();
-    let ranges = col.ranges;
     lap(&mut t, &mut ctx.timings.prepare);
 
     let bodies = &mut ctx.bodies[..];

@@ -9,7 +9,7 @@
 //! (`dp`, `dq`) accumulated since the start of the step. Impulses are per substep inside and
 //! stored per step outside.
 
-use super::coloring::{colour, solve_coloured};
+use super::coloring::solve_coloured;
 use super::timing::lap;
 use super::{contact, joints, Softness, StepContext};
 use crate::integrate;
@@ -34,13 +34,9 @@ pub(crate) fn step(ctx: &mut StepContext) {
         0.0
     };
     let (soft, static_soft) = contact::softness_pair(&p, h);
-    let cons = contact::prepare(ctx.manifolds, ctx.set, ctx.bodies, warm, soft, static_soft);
+    let (mut cons, ranges) =
+        contact::prepare(ctx.manifolds, ctx.set, ctx.bodies, warm, soft, static_soft);
     let mut rows = joints::build_all(ctx.joints, ctx.set, ctx.bodies, h, warm);
-    let dynamic: Vec<bool> = ctx.bodies.iter().map(|b| b.dynamic).collect();
-    let pairs: Vec<(usize, usize)> = cons.iter().map(|c| (c.a, c.b)).collect();
-    let col = colour(&pairs, &dynamic);
-    let mut cons: Vec<_> = col.order.iter().map(|&k| cons[k].clone()).collect();
-    let ranges = col.ranges;
     let joint_soft = Softness::new(p.joint_hertz, p.joint_damping_ratio, h);
     let (par, min) = (ctx.parallel, p.parallel_min_batch);
     let max_push = p.max_push_velocity;
