@@ -4,11 +4,14 @@
 use super::contact::FeatureId;
 use super::polyhedron::{clip_faces, polyhedron_manifold_into, Polyhedron};
 use crate::math::{Isometry, Real, Vec3};
+use crate::query::contact_cuboid_cuboid::{
+    cuboid_cuboid_sat, cuboid_cuboid_witness, Axis, CuboidSat,
+};
 use crate::query::epa::epa;
 use crate::query::gjk::{gjk, GjkResult};
 use crate::query::support_adapters::{Support, Transformed};
 use crate::query::{contact_convex, Contact};
-use crate::shape::{ConvexRef, SupportMap};
+use crate::shape::{ConvexRef, Cuboid, SupportMap};
 use smallvec::SmallVec;
 
 /// The feature id of a single GJK/EPA point.
@@ -91,6 +94,10 @@ pub fn polyhedron_manifold_guided(
     prediction: Real,
     out: &mut Vec<(Contact, FeatureId)>,
 ) {
+    if let (ConvexRef::Cuboid(x), ConvexRef::Cuboid(y)) = (ca, cb) {
+        cuboid_cuboid_manifold_into(x, y, a, b, pose_ab, prediction, out);
+        return;
+    }
     let Some(c) = contact_convex(ca, cb, pose_ab, prediction) else {
         return;
     };
@@ -103,6 +110,68 @@ pub fn polyhedron_manifold_guided(
         polyhedron_manifold_into(a, b, pose_ab, prediction, out);
         return;
     }
+    clip_guided(a, b, c, pose_ab, prediction, out);
+}
+
+/// Box–box: the boxes' own separating-axis test (15 axes, exact) gives the normal; a face
+/// axis is the reference face directly (its witness points are not needed when clipping
+/// succeeds), an edge axis or a separated pair goes through [`clip_guided`] as for hulls.
+fn cuboid_cuboid_manifold_into(
+    x: &Cuboid,
+    y: &Cuboid,
+    a: &Polyhedron,
+    b: &Polyhedron,
+    pose_ab: &Isometry,
+    prediction: Real,
+    out: &mut Vec<(Contact, FeatureId)>,
+) {
+    let (depth, n, axis) = match cuboid_cuboid_sat(x, y, pose_ab, prediction) {
+        CuboidSat::Final(None) => return,
+        CuboidSat::Final(Some(c)) => return clip_guided(a, b, c, pose_ab, prediction, out),
+        CuboidSat::Overlap {
+            depth,
+            normal,
+            axis,
+        } => (depth, normal, axis),
+    };
+    if -depth > prediction {
+        return;
+    }
+    let start = out.len();
+    match axis {
+        Axis::FaceA(i) => {
+            let fa = 2 * i + (n[i] < 0.0) as usize;
+            clip_faces(a, fa, b, pose_ab, prediction, (fa as u32 & 0x3F) << 24, out);
+        }
+        Axis::FaceB(j) => {
+            let nb = pose_ab.inverse_transform_vector(-n);
+            let fb = 2 * j + (nb[j] < 0.0) as usize;
+            let id_base = ((fb as u32 & 0x3F) | 0x40) << 24;
+            let mut tmp: SmallVec<[(Contact, FeatureId); 16]> = SmallVec::new();
+            clip_faces(b, fb, a, &pose_ab.inverse(), prediction, id_base, &mut tmp);
+            out.extend(
+                tmp.into_iter()
+                    .map(|(c, id)| (c.swapped().transformed(pose_ab), id)),
+            );
+        }
+        Axis::Edge(..) => {}
+    }
+    if out.len() == start {
+        let c = cuboid_cuboid_witness(x, y, pose_ab, depth, n, axis);
+        clip_guided(a, b, c, pose_ab, prediction, out);
+    }
+}
+
+/// Clips the faces selected by the contact `c` (within about 2.6° of a face normal of A or
+/// B), else keeps `c` as the single point.
+fn clip_guided(
+    a: &Polyhedron,
+    b: &Polyhedron,
+    c: Contact,
+    pose_ab: &Isometry,
+    prediction: Real,
+    out: &mut Vec<(Contact, FeatureId)>,
+) {
     let best_face = |p: &Polyhedron, n: Vec3| {
         p.faces()
             .iter()
