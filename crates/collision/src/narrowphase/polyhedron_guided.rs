@@ -200,7 +200,13 @@ fn clip_guided(
                 .map(|(c, id)| (c.swapped().transformed(pose_ab), id)),
         );
     }
-    if out.len() == start {
+    // Clipping keeps the incident face only; when the deepest point is elsewhere (deep or
+    // lateral contacts) the GJK/EPA point joins, so the manifold's depth stays exact.
+    let clipped_min = out[start..]
+        .iter()
+        .map(|(k, _)| k.distance)
+        .fold(Real::INFINITY, Real::min);
+    if out.len() == start || clipped_min > c.distance + 1.0e-3 * (1.0 + c.distance.abs()) {
         out.push((c, EPA_FEATURE));
     }
 }
