@@ -8,7 +8,12 @@
 //!
 //! Each measurement updates 64 manifolds (one per configuration, a shallow penetration of
 //! 1 cm at a random orientation) once, for both libraries, with the same prediction
-//! distance. `contacts/*`: persistent manifolds at an unchanged pose, the steady state of a
+//! distance (2 cm: points are generated up to 2 cm apart in both) and the same inputs (the
+//! relative poses converted once; Carom also receives A's pose and composes the relative
+//! pose itself). Neither library takes a requested point count: Carom reduces to at most 4
+//! points per manifold, parry3d keeps every clipped point within the prediction, so parry3d
+//! does more work per manifold on the polyhedral pairs; the point totals of both are printed
+//! after each group so the comparison can be read with that in mind. `contacts/*`: persistent manifolds at an unchanged pose, the steady state of a
 //! resting pile (both libraries reuse the points by spatial coherence); `contacts-fresh/*`:
 //! the manifolds (and parry's workspaces) are cleared first, so every call generates the
 //! contacts from scratch. parry3d uses glam 0.33:

@@ -214,3 +214,42 @@ fn sliding_box_keeps_features_and_impulses_then_lifts_off() {
         .unwrap();
     assert!(m.is_empty());
 }
+
+#[test]
+fn box_overhanging_an_edge_gives_the_corners_of_the_overlap() {
+    // Oracle: the overlap of the top face [-2, 2]² of the ground with the bottom face
+    // [1.3, 2.3] × [-0.5, 0.5] (+0.2 in z) of the box is [1.3, 2.0] × [-0.3, 0.7], 1 cm deep.
+    let d = Dispatcher::default();
+    let ground = cuboid(2.0, 0.5, 2.0);
+    let b = cuboid(0.5, 0.5, 0.5);
+    let pb = Isometry::from_translation(Vec3::new(1.8, 1.0 - 0.01, 0.2));
+    for swap in [false, true] {
+        let m = if swap {
+            step(&d, &b, &pb, &ground, &Isometry::IDENTITY)
+        } else {
+            step(&d, &ground, &Isometry::IDENTITY, &b, &pb)
+        };
+        assert_eq!(m.len(), 4, "{:?}", m.points);
+        let mut hit = [false; 4];
+        let corners = [(1.3, -0.3), (1.3, 0.7), (2.0, -0.3), (2.0, 0.7)];
+        for p in &m.points {
+            assert!((p.distance + 0.01).abs() < 1e-4, "depth {}", p.distance);
+            let (lo, hi) = (
+                p.point_a().y.min(p.point_b.y),
+                p.point_a().y.max(p.point_b.y),
+            );
+            assert!(
+                (lo - 0.49).abs() < 1e-4 && (hi - 0.5).abs() < 1e-4,
+                "{lo} {hi}"
+            );
+            let k = corners
+                .iter()
+                .position(|&(x, z)| {
+                    (p.point_b.x - x).abs() < 1e-4 && (p.point_b.z - z).abs() < 1e-4
+                })
+                .unwrap_or_else(|| panic!("{:?} is not a corner of the overlap", p.point_b));
+            hit[k] = true;
+        }
+        assert!(hit.iter().all(|&h| h), "{hit:?}");
+    }
+}

@@ -265,3 +265,53 @@ fn cylinder_standing_on_a_mesh_gets_three_points_by_caching() {
     }
     assert!(best > 0.01, "footprint area {best}");
 }
+
+#[test]
+fn registered_user_algorithm_produces_the_points_in_both_orders() {
+    use carom_collision::query::Contact;
+    let mut d = Dispatcher::default();
+    // A user algorithm for sphere–box: one point at B's origin, 5 mm deep, normal +Y (A's
+    // frame, from A to B), with a recognisable feature id.
+    d.register(
+        ShapeKind::Sphere,
+        ShapeKind::Cuboid,
+        Arc::new(|_, _, pose_ab, _, _| Generated {
+            contacts: vec![(
+                Contact {
+                    distance: -0.005,
+                    point_a: pose_ab.translation + Vec3::Y * 0.005,
+                    point_b: pose_ab.translation,
+                    normal: Vec3::Y,
+                },
+                77,
+            )],
+            full: true,
+        }),
+    );
+    let sphere = Shape::Sphere(Sphere::new(0.5).unwrap());
+    let cube = Shape::Cuboid(Cuboid::new(Vec3::splat(0.5)).unwrap());
+    let far = Isometry::from_translation(Vec3::new(10.0, 0.0, 0.0));
+    let mut m = ContactManifold::new();
+    d.update_manifold(&sphere, &Isometry::IDENTITY, &cube, &far, &mut m)
+        .unwrap();
+    assert_eq!(
+        m.len(),
+        1,
+        "the user algorithm runs even though the shapes are apart"
+    );
+    assert_eq!(m.points[0].feature, 77);
+    assert!((m.points[0].point_b - far.translation).length() < 1e-6);
+    assert!(
+        (m.points[0].normal + Vec3::Y).length() < 1e-6,
+        "normal on B, from B to A"
+    );
+    // Reversed pair: through the swap adapter, the same contact seen from the box.
+    let mut r = ContactManifold::new();
+    d.update_manifold(&cube, &far, &sphere, &Isometry::IDENTITY, &mut r)
+        .unwrap();
+    assert_eq!(r.len(), 1);
+    assert_eq!(r.points[0].feature, 77);
+    assert!((r.points[0].distance + 0.005).abs() < 1e-6);
+    assert!((r.points[0].point_a() - far.translation).length() < 1e-5);
+    assert!((r.points[0].normal - Vec3::Y).length() < 1e-6);
+}

@@ -20,6 +20,7 @@ pub mod convex;
 pub mod dispatcher;
 pub mod mesh;
 pub mod polyhedron;
+pub mod polyhedron_guided;
 pub mod triangle_cuboid;
 
 pub use dispatcher::{Dispatcher, Generated, UserAlgorithm};

@@ -6,14 +6,14 @@
 //! Serves boxes, convex hulls and triangles alike.
 
 use super::contact::FeatureId;
+pub use super::polyhedron_guided::{
+    polyhedron_contact, polyhedron_manifold_guided, EPA_FEATURE, SAT_MAX_EDGE_PAIRS,
+};
 use crate::math::{Isometry, Real, Vec3};
 use crate::query::closest_points::closest_points_segment_segment;
-use crate::query::epa::epa;
-use crate::query::gjk::{gjk, GjkResult};
-use crate::query::support_adapters::{Support, Transformed};
-use crate::query::{contact_convex, Contact};
+use crate::query::Contact;
 use crate::shape::convex_hull::edge_face_pairs;
-use crate::shape::{ConvexHull, ConvexRef, Cuboid, HullFace, SupportMap, Triangle};
+use crate::shape::{ConvexHull, Cuboid, HullFace, Triangle};
 use smallvec::SmallVec;
 use std::sync::OnceLock;
 
@@ -284,7 +284,18 @@ fn edge_query(
                 (ax.dot(pb - pa), ax)
             };
             if s > best.0 {
-                best = (s, i, j, ax);
+                // Gregorius' edge distance holds only for a true Minkowski face; near the
+                // Gauss-map test's round-off it can overstate the separation (the polytope
+                // oracle caught depths 15 % short). A new best is checked by projecting both
+                // shapes, which is exact for any axis.
+                let exact = if flat {
+                    s
+                } else {
+                    -max_dot(vb, -ax) - max_dot(va, ax)
+                };
+                if exact > best.0 {
+                    best = (exact, i, j, ax);
+                }
             }
         }
     }
@@ -506,65 +517,82 @@ pub fn polyhedron_manifold_into(
         let id_base = (fa as u32 & 0x3F) << 24;
         clip_faces(a, fa, b, pose_ab, prediction, id_base, out);
     }
+    let best = sa.max(sb).max(se);
+    let slack = FACE_PREFERENCE * (1.0 + best.abs());
+    let clipped_min = out[start..]
+        .iter()
+        .map(|(c, _)| c.distance)
+        .fold(Real::INFINITY, Real::min);
+    if out.len() > start && clipped_min > best + slack && (sa >= best || sb >= best) {
+        // The incident face does not hold the deepest vertex (deep or lateral contact):
+        // add the deepest vertex along the SAT's face axis, so the manifold's depth is the
+        // minimum penetration.
+        out.push((
+            sat_point(a, (&vb, &nb, &ob), (sa, fa), fb, best),
+            EPA_FEATURE,
+        ));
+    }
     if out.len() == start {
         // The clipped face lies beyond the prediction or beside the reference face while
         // the shapes overlap (the deepest vertex is not on the incident face): one GJK/EPA
-        // point on the polyhedra themselves.
-        out.extend(polyhedron_contact(a, b, pose_ab, prediction).map(|c| (c, EPA_FEATURE)));
-    }
-}
-
-/// The feature id of a single GJK/EPA point.
-pub(crate) const EPA_FEATURE: FeatureId = 0x8000_0000 | 0x7FFF_FFFF;
-
-impl Support for Polyhedron<'_> {
-    /// The vertex maximising `v · dir` (first on ties), by a scan of the vertices.
-    fn support(&self, dir: Vec3) -> Vec3 {
-        let v = self.vertices();
-        let mut best = v.first().copied().unwrap_or(Vec3::ZERO);
-        let mut best_d = best.dot(dir);
-        for p in v.iter().skip(1) {
-            let d = p.dot(dir);
-            if d > best_d {
-                best_d = d;
-                best = *p;
+        // point on the polyhedra themselves, if it agrees with the SAT's separation (EPA
+        // stopping early returns its lower bound, a shallower depth); else the deepest
+        // vertex along the SAT's face axis.
+        match polyhedron_contact(a, b, pose_ab, prediction) {
+            Some(c) if c.distance <= best + slack => {
+                out.push((c, EPA_FEATURE));
             }
+            _ if best <= prediction && (sa >= best || sb >= best) => {
+                let c = sat_point(a, (&vb, &nb, &ob), (sa, fa), fb, best);
+                out.push((c, EPA_FEATURE));
+            }
+            _ => {}
         }
-        best
     }
 }
 
-/// GJK/EPA contact of two polyhedra (B at `pose_ab`), in A's frame; `None` beyond
-/// `prediction`.
-pub fn polyhedron_contact(
+/// The deepest vertex along the SAT's best face axis (A's face `fa` when `sa` is the best
+/// separation `best`, else B's face `fb`, given in A's frame by `nb`/`ob`), as a contact in
+/// A's frame. `vb`: B's vertices in A's frame.
+fn sat_point(
     a: &Polyhedron,
-    b: &Polyhedron,
-    pose_ab: &Isometry,
-    prediction: Real,
-) -> Option<Contact> {
-    let tb = Transformed::new(*b, pose_ab);
-    match gjk(a, &tb, -pose_ab.translation, prediction) {
-        GjkResult::BeyondMaxDistance => None,
-        GjkResult::Separated {
-            distance,
-            point_a,
-            point_b,
-        } => (distance <= prediction && distance > 0.0).then(|| Contact {
-            distance,
-            point_a,
-            point_b,
-            normal: (point_b - point_a) / distance,
-        }),
-        GjkResult::Overlapping(simplex) => {
-            let p = epa(a, &tb, &simplex);
-            (p.depth.is_finite() && p.normal.is_finite()).then_some(Contact {
-                distance: -p.depth,
-                point_a: p.point_a,
-                point_b: p.point_b,
-                normal: p.normal,
-            })
+    (vb, nb, ob): (&[Vec3], &[Vec3], &[Real]),
+    (sa, fa): (Real, usize),
+    fb: usize,
+    best: Real,
+) -> Contact {
+    if sa >= best {
+        let HullFace { normal, offset, .. } = a.faces[fa];
+        let p = deepest(vb, normal);
+        let d = normal.dot(p) - offset;
+        Contact {
+            distance: d,
+            point_a: p - normal * d,
+            point_b: p,
+            normal,
+        }
+    } else {
+        let (m, off) = (nb[fb], ob[fb]);
+        let p = deepest(a.vertices(), m);
+        let d = m.dot(p) - off;
+        Contact {
+            distance: d,
+            point_a: p,
+            point_b: p - m * d,
+            normal: -m,
         }
     }
+}
+
+/// The point of `points` with the smallest projection on `n` (first on ties).
+fn deepest(points: &[Vec3], n: Vec3) -> Vec3 {
+    let mut best = points.first().copied().unwrap_or(Vec3::ZERO);
+    for p in points.iter().skip(1) {
+        if p.dot(n) < best.dot(n) {
+            best = *p;
+        }
+    }
+    best
 }
 
 /// The contact feature the separating-axis test settles on.
@@ -615,78 +643,6 @@ pub(crate) fn edge_contact(
         point_b: ca + axis * se,
         normal: axis,
     })
-}
-
-/// Up to this many edge pairs (and always with a triangle) the dispatcher runs the full
-/// separating-axis test, quadratic in the edge count; boxes and hulls go through
-/// [`polyhedron_manifold_guided`].
-pub const SAT_MAX_EDGE_PAIRS: usize = 16;
-
-/// Cosine under which a contact normal counts as a face normal in
-/// [`polyhedron_manifold_guided`] (about 2.6 degrees).
-const FACE_COS: Real = 0.999;
-
-/// The full manifold of two polyhedra guided by GJK/EPA instead of the full SAT (the approach
-/// of parry's `contact_manifolds_pfm_pfm` and Bullet's `btPolyhedralContactClipping` after
-/// a GJK normal): one penetration query gives the normal `n`; when `n` is within about 2.6°
-/// of a face normal of A (or of B), that face is the reference face and the other shape's
-/// most anti-parallel face is clipped against it as in [`polyhedron_manifold`]; otherwise
-/// (edge–edge, vertex contacts) the single GJK/EPA point is the manifold. Cost: one GJK/EPA
-/// plus a scan of the faces, linear in the size of the shapes. `ca`/`cb` are the shapes
-/// behind the views `a`/`b`.
-#[allow(clippy::too_many_arguments)]
-pub fn polyhedron_manifold_guided(
-    a: &Polyhedron,
-    b: &Polyhedron,
-    ca: ConvexRef<'_>,
-    cb: ConvexRef<'_>,
-    pose_ab: &Isometry,
-    prediction: Real,
-    out: &mut Vec<(Contact, FeatureId)>,
-) {
-    let Some(c) = contact_convex(ca, cb, pose_ab, prediction) else {
-        return;
-    };
-    // The shapes' exact separation along the returned normal must be the returned
-    // distance; when it is not (EPA on a degenerate polytope, e.g. shapes touching within
-    // round-off), run the full separating-axis test instead.
-    let n = c.normal;
-    let sep = n.dot(cb.support_world(pose_ab, -n)) - n.dot(ca.support(n));
-    if !(sep - c.distance).is_finite() || (sep - c.distance).abs() > 1.0e-4 * (1.0 + sep.abs()) {
-        polyhedron_manifold_into(a, b, pose_ab, prediction, out);
-        return;
-    }
-    let best_face = |p: &Polyhedron, n: Vec3| {
-        p.faces()
-            .iter()
-            .enumerate()
-            .fold((0, Real::NEG_INFINITY), |best, (i, f)| {
-                let d = f.normal.dot(n);
-                if d > best.1 {
-                    (i, d)
-                } else {
-                    best
-                }
-            })
-    };
-    let (fa, da) = best_face(a, c.normal);
-    let (fb, db) = best_face(b, pose_ab.inverse_transform_vector(-c.normal));
-    let start = out.len();
-    if da >= FACE_COS && da + 1.0e-4 >= db {
-        let id_base = (fa as u32 & 0x3F) << 24;
-        clip_faces(a, fa, b, pose_ab, prediction, id_base, out);
-    } else if db >= FACE_COS {
-        let id_base = ((fb as u32 & 0x3F) | 0x40) << 24;
-        let mut tmp: SmallVec<[(Contact, FeatureId); 16]> = SmallVec::new();
-        clip_faces(b, fb, a, &pose_ab.inverse(), prediction, id_base, &mut tmp);
-        out.extend(
-            tmp.into_iter()
-                .map(|(c, id)| (c.swapped().transformed(pose_ab), id)),
-        );
-    }
-    if out.len() == start {
-        out.push((c, EPA_FEATURE));
-    }
 }
 
 /// Polyhedron B (at `pose_ab`) against the half-space `n · x <= offset` of A: every vertex

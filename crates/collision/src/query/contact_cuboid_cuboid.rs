@@ -16,11 +16,32 @@ use super::support_adapters::{Core, Transformed};
 use crate::math::{Isometry, Mat3, Real, Vec3, EPSILON};
 use crate::shape::{ConvexRef, Cuboid};
 
-#[derive(Clone, Copy)]
-enum Axis {
+/// The axis of least overlap of two overlapping boxes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Axis {
+    /// Face normal `i` of A.
     FaceA(usize),
+    /// Face normal `j` of B.
     FaceB(usize),
+    /// Edge `i` of A crossed with edge `j` of B.
     Edge(usize, usize),
+}
+
+/// The outcome of the boxes' separating-axis test.
+#[derive(Debug, Clone, Copy)]
+pub enum CuboidSat {
+    /// Apart or touching: the final contact (`None` beyond the prediction).
+    Final(Option<Contact>),
+    /// Overlapping: the least overlap `depth` along `normal` (from A to B) and its axis;
+    /// [`cuboid_cuboid_witness`] gives the witness points.
+    Overlap {
+        /// Penetration depth (>= 0).
+        depth: Real,
+        /// Unit normal from A towards B, in A's frame.
+        normal: Vec3,
+        /// The axis that gave it.
+        axis: Axis,
+    },
 }
 
 /// Box A against box B.
@@ -30,6 +51,25 @@ pub fn contact_cuboid_cuboid(
     pose_ab: &Isometry,
     prediction: Real,
 ) -> Option<Contact> {
+    match cuboid_cuboid_sat(a, b, pose_ab, prediction) {
+        CuboidSat::Final(c) => c,
+        CuboidSat::Overlap {
+            depth,
+            normal,
+            axis,
+        } => (-depth <= prediction)
+            .then(|| cuboid_cuboid_witness(a, b, pose_ab, depth, normal, axis)),
+    }
+}
+
+/// The separating-axis test of [`contact_cuboid_cuboid`] without the witness points of an
+/// overlap (a caller that clips faces does not need them).
+pub fn cuboid_cuboid_sat(
+    a: &Cuboid,
+    b: &Cuboid,
+    pose_ab: &Isometry,
+    prediction: Real,
+) -> CuboidSat {
     let ha = a.half_extents();
     let hb = b.half_extents();
     let rot = pose_ab.rotation_matrix();
@@ -79,47 +119,66 @@ pub fn contact_cuboid_cuboid(
     }
     if !overlapping {
         let Some((overlap, n)) = sep else {
-            return contact_gjk_epa(
+            return CuboidSat::Final(contact_gjk_epa(
                 ConvexRef::Cuboid(a),
                 ConvexRef::Cuboid(b),
                 pose_ab,
                 prediction,
-            );
+            ));
         };
         let core_b = Transformed::new(Core(ConvexRef::Cuboid(b)), pose_ab);
-        return match gjk(&Core(ConvexRef::Cuboid(a)), &core_b, -t, prediction) {
-            GjkResult::BeyondMaxDistance => None,
-            GjkResult::Separated {
-                distance,
-                point_a,
-                point_b,
-            } => (distance <= prediction).then(|| Contact {
-                distance,
-                point_a,
-                point_b,
-                normal: (point_b - point_a) / distance,
-            }),
-            // A separating axis exists, yet GJK counts the boxes as overlapping: they touch
-            // within round-off, where EPA's polytope is degenerate (it reported depths of
-            // metres in the polytope oracle). GJK's witnesses are the touching points and
-            // the separating axis is the normal.
-            GjkResult::Overlapping(simplex) => {
-                let (point_a, _) = simplex.witnesses();
-                let gap = -overlap;
-                (gap <= prediction).then_some(Contact {
-                    distance: gap,
+        return CuboidSat::Final(
+            match gjk(&Core(ConvexRef::Cuboid(a)), &core_b, -t, prediction) {
+                GjkResult::BeyondMaxDistance => None,
+                GjkResult::Separated {
+                    distance,
                     point_a,
-                    point_b: point_a + n * gap,
-                    normal: n,
-                })
-            }
-        };
+                    point_b,
+                } => (distance <= prediction).then(|| Contact {
+                    distance,
+                    point_a,
+                    point_b,
+                    normal: (point_b - point_a) / distance,
+                }),
+                // A separating axis exists, yet GJK counts the boxes as overlapping: they touch
+                // within round-off, where EPA's polytope is degenerate (it reported depths of
+                // metres in the polytope oracle). GJK's witnesses are the touching points and
+                // the separating axis is the normal.
+                GjkResult::Overlapping(simplex) => {
+                    let (point_a, _) = simplex.witnesses();
+                    let gap = -overlap;
+                    (gap <= prediction).then_some(Contact {
+                        distance: gap,
+                        point_a,
+                        point_b: point_a + n * gap,
+                        normal: n,
+                    })
+                }
+            },
+        );
     }
-    let (depth, n, kind) = best.expect("at least the face axes were tested");
-    if -depth > prediction {
-        return None;
+    let (depth, normal, axis) = best.expect("at least the face axes were tested");
+    CuboidSat::Overlap {
+        depth,
+        normal,
+        axis,
     }
-    Some(match kind {
+}
+
+/// The witness points of an overlap found by [`cuboid_cuboid_sat`].
+pub fn cuboid_cuboid_witness(
+    a: &Cuboid,
+    b: &Cuboid,
+    pose_ab: &Isometry,
+    depth: Real,
+    n: Vec3,
+    kind: Axis,
+) -> Contact {
+    let (ha, hb) = (a.half_extents(), b.half_extents());
+    let rot = pose_ab.rotation_matrix();
+    let t = pose_ab.translation;
+    let bx = [rot.x_axis, rot.y_axis, rot.z_axis];
+    match kind {
         Axis::FaceA(i) => {
             let (pa, pb) = face_witness(ha, hb, &Mat3::from_cols(bx[0], bx[1], bx[2]), t, i, n);
             Contact {
@@ -168,7 +227,7 @@ pub fn contact_cuboid_cuboid(
                 normal: n,
             }
         }
-    })
+    }
 }
 
 /// Witness points for a face axis of the reference box (half extents `hr`, at the origin)
