@@ -175,15 +175,20 @@ impl Block {
     pub fn new(start: usize, rows: &[Row], a: &SolverBody, b: &SolverBody) -> Option<Block> {
         let len = rows.len();
         debug_assert!((1..=3).contains(&len));
+        // K_ij = J_i M⁻¹ J_jᵀ: one inverse-inertia product per row, then dot products.
         let mut k = Mat3::IDENTITY;
-        for i in 0..len {
-            for j in 0..len {
-                let (ri, rj) = (&rows[i], &rows[j]);
+        let ang: [(Vec3, Vec3); 3] = std::array::from_fn(|j| {
+            let r = &rows[j.min(len - 1)];
+            (a.inv_i * r.ang_a, b.inv_i * r.ang_b)
+        });
+        for (j, rj) in rows.iter().enumerate() {
+            for (i, ri) in rows.iter().enumerate().take(j + 1) {
                 let kij = a.inv_m * ri.lin_a.dot(rj.lin_a)
                     + b.inv_m * ri.lin_b.dot(rj.lin_b)
-                    + ri.ang_a.dot(a.inv_i * rj.ang_a)
-                    + ri.ang_b.dot(b.inv_i * rj.ang_b);
+                    + ri.ang_a.dot(ang[j].0)
+                    + ri.ang_b.dot(ang[j].1);
                 k.col_mut(j)[i] = kij;
+                k.col_mut(i)[j] = kij;
             }
         }
         let diag: Real = (0..3).map(|i| k.col(i)[i]).product();
