@@ -167,10 +167,8 @@ fn fill_rows(joint: &Joint, set: &BodySet, bodies: &[SolverBody], h: Real, jr: &
         }
     }
     let (sa, sb) = (&bodies[a], &bodies[b]);
-    for (_, row) in rows.iter_mut() {
-        *row = row.finish(sa, sb);
-    }
-    // Runs of up to three consecutive equality rows become blocks.
+    // Runs of up to three consecutive equality rows become blocks; the other rows (and the
+    // rows of a block too ill-conditioned to invert) get their scalar effective mass.
     jr.blocks.clear();
     let mut i = 0;
     while i < rows.len() {
@@ -178,14 +176,23 @@ fn fill_rows(joint: &Joint, set: &BodySet, bodies: &[SolverBody], h: Real, jr: &
         while end < rows.len() && end - i < 3 && rows[end].1.kind == RowKind::Equality {
             end += 1;
         }
-        if end - i >= 2 {
-            let run: [Row; 3] = std::array::from_fn(|k| rows[(i + k).min(end - 1)].1);
-            if let Some(block) = Block::new(i, &run[..end - i], sa, sb) {
-                jr.blocks.push(block);
-            }
-            i = end;
+        let block = if end - i >= 2 {
+            Block::new(i, &rows[i..end], sa, sb)
         } else {
-            i += 1;
+            None
+        };
+        match block {
+            Some(block) => {
+                jr.blocks.push(block);
+                i = end;
+            }
+            None => {
+                let end = end.max(i + 1);
+                for (_, row) in &mut rows[i..end] {
+                    *row = row.finish(sa, sb);
+                }
+                i = end;
+            }
         }
     }
 }

@@ -170,19 +170,24 @@ pub(crate) struct Block {
 }
 
 impl Block {
-    /// The block over `rows` (all equality rows), or `None` when its `K` is singular (then
-    /// the rows are solved one by one).
-    pub fn new(start: usize, rows: &[Row], a: &SolverBody, b: &SolverBody) -> Option<Block> {
+    /// The block over `rows` (all equality rows, with their slots), or `None` when its `K`
+    /// is nearly singular (then the rows are solved one by one).
+    pub fn new(
+        start: usize,
+        rows: &[(usize, Row)],
+        a: &SolverBody,
+        b: &SolverBody,
+    ) -> Option<Block> {
         let len = rows.len();
         debug_assert!((1..=3).contains(&len));
         // K_ij = J_i M⁻¹ J_jᵀ: one inverse-inertia product per row, then dot products.
         let mut k = Mat3::IDENTITY;
         let ang: [(Vec3, Vec3); 3] = std::array::from_fn(|j| {
-            let r = &rows[j.min(len - 1)];
+            let r = &rows[j.min(len - 1)].1;
             (a.inv_i * r.ang_a, b.inv_i * r.ang_b)
         });
-        for (j, rj) in rows.iter().enumerate() {
-            for (i, ri) in rows.iter().enumerate().take(j + 1) {
+        for (j, (_, rj)) in rows.iter().enumerate() {
+            for (i, (_, ri)) in rows.iter().enumerate().take(j + 1) {
                 let kij = a.inv_m * ri.lin_a.dot(rj.lin_a)
                     + b.inv_m * ri.lin_b.dot(rj.lin_b)
                     + ri.ang_a.dot(ang[j].0)
