@@ -10,20 +10,22 @@
 
 use super::{Axis, AxisMode, Joint, JointKind};
 use crate::body_set::BodySet;
-use crate::solver::rows::{Row, RowKind};
+use crate::solver::rows::{Block, Row, RowKind};
 use crate::solver::{Softness, SolverBody};
 use carom_collision::math::{Quat, Real, Vec3};
 
 /// Row slots per joint: 6 axes × (lower/equality, upper, motor).
 pub(crate) const ROW_SLOTS: usize = 18;
 
-/// The rows of one joint this step, each with its warm-starting slot.
+/// The rows of one joint this step, each with its warm-starting slot, and the runs of
+/// equality rows solved as blocks.
 #[derive(Debug, Clone)]
 pub(crate) struct JointRows {
     pub joint: usize,
     pub a: usize,
     pub b: usize,
     pub rows: Vec<(usize, Row)>,
+    pub blocks: Vec<Block>,
 }
 
 /// Rotation vector (axis × angle, angle in `[0, π]`) of a unit quaternion.
@@ -71,6 +73,49 @@ pub(crate) fn build_rows(
     if joint.broken || !(bodies[a].dynamic || bodies[b].dynamic) {
         return None;
     }
+    let mut jr = JointRows {
+        joint: index,
+        a,
+        b,
+        rows: Vec::with_capacity(6),
+        blocks: Vec::with_capacity(2),
+    };
+    fill_rows(joint, set, bodies, h, &mut jr);
+    for (slot, row) in jr.rows.iter_mut() {
+        row.impulse = (joint.impulses[*slot] * impulse_in).clamp(row.lo, row.hi);
+    }
+    Some(jr)
+}
+
+/// Rebuilds the rows of `jr` from the bodies' *current* poses (the soft step moves them every
+/// substep), keeping each slot's accumulated impulse. Box2D v3 rotates the anchors by each
+/// body's delta rotation in every solve (`b2SolveRevoluteJoint`); a row built once per step
+/// keeps the lever arms and axes of the step start, a linearisation that lets the joint
+/// drift and pump energy. `C` is shifted by `-J·(dp, dq)` so that the delta tracking of
+/// [`Row::solve`] starts from the current error.
+pub(crate) fn refresh_rows(
+    jr: &mut JointRows,
+    joint: &Joint,
+    set: &BodySet,
+    bodies: &[SolverBody],
+    h: Real,
+) {
+    let mut impulses = [0.0; ROW_SLOTS];
+    for (slot, row) in &jr.rows {
+        impulses[*slot] = row.impulse;
+    }
+    fill_rows(joint, set, bodies, h, jr);
+    let (sa, sb) = (&bodies[jr.a], &bodies[jr.b]);
+    for (slot, row) in jr.rows.iter_mut() {
+        row.impulse = impulses[*slot].clamp(row.lo, row.hi);
+        row.c -= row.delta(sa, sb);
+    }
+}
+
+/// Fills `jr.rows` and `jr.blocks` (cleared first, capacity kept) from the current poses.
+fn fill_rows(joint: &Joint, set: &BodySet, bodies: &[SolverBody], h: Real, jr: &mut JointRows) {
+    let desc = &joint.desc;
+    let (a, b) = (jr.a, jr.b);
     let fa = set.pose_of(a).mul(&desc.frame_a);
     let fb = set.pose_of(b).mul(&desc.frame_b);
     let d = fb.translation - fa.translation;
@@ -83,13 +128,14 @@ pub(crate) fn build_rows(
         rot_b: fb.rotation,
         q_rel,
     };
-    let mut rows: Vec<(usize, Row)> = Vec::with_capacity(6);
+    let rows = &mut jr.rows;
+    rows.clear();
     let lock = Axis::default();
     match desc.kind {
-        JointKind::Ball => linear_axes(&f, &[lock; 3], h, &mut rows),
+        JointKind::Ball => linear_axes(&f, &[lock; 3], h, rows),
         JointKind::Fixed => {
-            linear_axes(&f, &[lock; 3], h, &mut rows);
-            angular_axes(&f, &[lock; 3], h, &mut rows);
+            linear_axes(&f, &[lock; 3], h, rows);
+            angular_axes(&f, &[lock; 3], h, rows);
         }
         JointKind::Slider { limits, motor } => {
             let x = Axis {
@@ -100,37 +146,55 @@ pub(crate) fn build_rows(
                 motor,
                 spring: None,
             };
-            linear_axes(&f, &[x, lock, lock], h, &mut rows);
-            angular_axes(&f, &[lock; 3], h, &mut rows);
+            linear_axes(&f, &[x, lock, lock], h, rows);
+            angular_axes(&f, &[lock; 3], h, rows);
         }
         JointKind::Generic6Dof { linear, angular } => {
-            linear_axes(&f, &linear, h, &mut rows);
-            angular_axes(&f, &angular, h, &mut rows);
+            linear_axes(&f, &linear, h, rows);
+            angular_axes(&f, &angular, h, rows);
         }
         JointKind::Hinge { limits, motor } => {
-            linear_axes(&f, &[lock; 3], h, &mut rows);
-            hinge(&f, limits, motor, h, &mut rows);
+            linear_axes(&f, &[lock; 3], h, rows);
+            hinge(&f, limits, motor, h, rows);
         }
         JointKind::ConeTwist {
             swing1,
             swing2,
             twist,
         } => {
-            linear_axes(&f, &[lock; 3], h, &mut rows);
-            cone_twist(&f, swing1, swing2, twist, &mut rows);
+            linear_axes(&f, &[lock; 3], h, rows);
+            cone_twist(&f, swing1, swing2, twist, rows);
         }
     }
     let (sa, sb) = (&bodies[a], &bodies[b]);
-    for (slot, row) in rows.iter_mut() {
-        *row = row.finish(sa, sb);
-        row.impulse = (joint.impulses[*slot] * impulse_in).clamp(row.lo, row.hi);
+    // Runs of up to three consecutive equality rows become blocks; the other rows (and the
+    // rows of a block too ill-conditioned to invert) get their scalar effective mass.
+    jr.blocks.clear();
+    let mut i = 0;
+    while i < rows.len() {
+        let mut end = i;
+        while end < rows.len() && end - i < 3 && rows[end].1.kind == RowKind::Equality {
+            end += 1;
+        }
+        let block = if end - i >= 2 {
+            Block::new(i, &rows[i..end], sa, sb)
+        } else {
+            None
+        };
+        match block {
+            Some(block) => {
+                jr.blocks.push(block);
+                i = end;
+            }
+            None => {
+                let end = end.max(i + 1);
+                for (_, row) in &mut rows[i..end] {
+                    *row = row.finish(sa, sb);
+                }
+                i = end;
+            }
+        }
     }
-    Some(JointRows {
-        joint: index,
-        a,
-        b,
-        rows,
-    })
 }
 
 /// Rows for one coordinate `value` along a generic axis: limits or lock, motor, spring.

@@ -10,7 +10,7 @@
 mod build;
 mod scene;
 
-pub(crate) use build::{build_rows, JointRows, ROW_SLOTS};
+pub(crate) use build::{build_rows, refresh_rows, JointRows, ROW_SLOTS};
 
 use crate::body_set::BodyHandle;
 use carom_collision::math::{check_finite, check_isometry, check_non_negative, Isometry, Real};
@@ -321,6 +321,10 @@ impl JointSet {
                 (h, j)
             })
         })
+    }
+
+    pub(crate) fn get_index(&self, i: usize) -> Option<&Joint> {
+        self.slots.get(i).and_then(|s| s.1.as_ref())
     }
 
     pub(crate) fn get_index_mut(&mut self, i: usize) -> Option<&mut Joint> {

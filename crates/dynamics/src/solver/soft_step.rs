@@ -42,10 +42,14 @@ pub(crate) fn step(ctx: &mut StepContext) {
     let max_push = p.max_push_velocity;
     lap(&mut t, &mut ctx.timings.prepare);
 
-    for _ in 0..n {
+    for substep in 0..n {
         integrate::integrate_velocities(ctx.set, ctx.bodies, ctx.gravity, h, ctx.gyroscopic);
         lap(&mut t, &mut ctx.timings.forces);
 
+        if substep > 0 {
+            // Joint rows follow the poses of the previous substep (built fresh for the first).
+            joints::refresh(&mut rows, ctx.joints, ctx.set, ctx.bodies, h);
+        }
         if p.warm_starting {
             joints::warm_start(&mut rows, ctx.bodies);
             solve_coloured(
@@ -69,6 +73,7 @@ pub(crate) fn step(ctx: &mut StepContext) {
         integrate::integrate_positions(ctx.set, ctx.bodies, h, false);
         lap(&mut t, &mut ctx.timings.integrate);
 
+        joints::refresh(&mut rows, ctx.joints, ctx.set, ctx.bodies, h);
         joints::solve(&mut rows, ctx.bodies, joint_soft, inv_h, false, true);
         solve_coloured(&mut cons, &ranges, ctx.bodies, par, min, |c, a, b| {
             contact::solve_soft(c, a, b, inv_h, max_push, false)
