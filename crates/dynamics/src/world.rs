@@ -10,7 +10,9 @@ use crate::contact::ContactManifold;
 use crate::integrate;
 use crate::island::{self, SleepParams};
 use crate::joint::{JointDesc, JointHandle, JointSet};
-use crate::solver::{self, SolverBody, SolverKind, SolverParams, StepContext, StepTimings};
+use crate::solver::{
+    self, SolverBody, SolverKind, SolverParams, SolverScratch, StepContext, StepTimings,
+};
 use carom_collision::math::{check_finite_vec, Real, Vec3};
 use carom_collision::{CaromError, Result};
 use serde::{Deserialize, Serialize};
@@ -67,6 +69,8 @@ pub struct DynamicsWorld {
     joints: JointSet,
     params: WorldParams,
     solver_bodies: Vec<SolverBody>,
+    /// The solver's constraint and colouring buffers, reused from step to step.
+    solver_scratch: SolverScratch,
 }
 
 impl DynamicsWorld {
@@ -78,6 +82,7 @@ impl DynamicsWorld {
             joints: JointSet::default(),
             params,
             solver_bodies: Vec::new(),
+            solver_scratch: SolverScratch::default(),
         })
     }
 
@@ -230,6 +235,7 @@ impl DynamicsWorld {
             gyroscopic: self.params.gyroscopic,
             parallel: self.params.parallel,
             timings: &mut report.timings,
+            scratch: &mut self.solver_scratch,
         };
         match self.params.solver.kind {
             SolverKind::SequentialImpulse => solver::sequential::step(&mut ctx),

@@ -26,15 +26,49 @@ pub(crate) struct Colouring {
     pub ranges: Vec<Range<usize>>,
 }
 
+/// Reusable buffers of [`colour_into`]: kept by the world between steps (cleared, not
+/// freed), so colouring allocates nothing once they have grown to the scene.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct ColourScratch {
+    /// Colour bit set of each body.
+    used: Vec<u32>,
+    /// Colour of each constraint.
+    colour_of: Vec<usize>,
+}
+
 /// Colours `pairs` (body slots of each constraint, below `body_count`); `dynamic(i)` tells
 /// whether body `i` is written by the solver.
+#[cfg(test)]
 pub(crate) fn colour(
     pairs: &[(usize, usize)],
     body_count: usize,
     dynamic: impl Fn(usize) -> bool,
 ) -> Colouring {
-    let mut used = vec![0u32; body_count];
-    let mut colour_of = Vec::with_capacity(pairs.len());
+    let mut out = Colouring::default();
+    colour_into(
+        pairs,
+        body_count,
+        dynamic,
+        &mut ColourScratch::default(),
+        &mut out,
+    );
+    out
+}
+
+/// [`colour`] into reused buffers: `out` is overwritten, `scratch` holds the working arrays.
+/// Allocates only when a buffer must grow.
+pub(crate) fn colour_into(
+    pairs: &[(usize, usize)],
+    body_count: usize,
+    dynamic: impl Fn(usize) -> bool,
+    scratch: &mut ColourScratch,
+    out: &mut Colouring,
+) {
+    let used = &mut scratch.used;
+    used.clear();
+    used.resize(body_count, 0);
+    let colour_of = &mut scratch.colour_of;
+    colour_of.clear();
     let mut counts = [0usize; COLOURS + 1];
     for &(a, b) in pairs {
         let (da, db) = (dynamic(a), dynamic(b));
@@ -57,16 +91,18 @@ pub(crate) fn colour(
         starts[c + 1] = starts[c] + counts[c];
     }
     let mut next = starts;
-    let mut order = vec![0; pairs.len()];
+    out.order.clear();
+    out.order.resize(pairs.len(), 0);
     for (k, &c) in colour_of.iter().enumerate() {
-        order[next[c]] = k;
+        out.order[next[c]] = k;
         next[c] += 1;
     }
-    let ranges = (0..=COLOURS)
-        .filter(|&c| counts[c] > 0 || c == COLOURS)
-        .map(|c| starts[c]..starts[c + 1])
-        .collect();
-    Colouring { order, ranges }
+    out.ranges.clear();
+    out.ranges.extend(
+        (0..=COLOURS)
+            .filter(|&c| counts[c] > 0 || c == COLOURS)
+            .map(|c| starts[c]..starts[c + 1]),
+    );
 }
 
 /// Runs `f` on every constraint, colour by colour. Inside a colour, constraints run in

@@ -7,12 +7,11 @@
 //! `btSequentialImpulseConstraintSolver::setupContactConstraint`). The anchor of a point is
 //! the midpoint of its two witness points, as in Box2D.
 
-use super::coloring::{colour, PairConstraint};
+use super::coloring::{colour_into, ColourScratch, Colouring, PairConstraint};
 use super::{inv_or_zero, Softness, SolverBody, SolverParams};
 use crate::body_set::BodySet;
 use crate::contact::{ContactManifold, MAX_MANIFOLD_POINTS};
 use carom_collision::math::{orthonormal_basis, Real, Vec3};
-use std::ops::Range;
 
 /// One Jacobian row of a contact point along a unit direction `d` (the normal or a tangent):
 /// the angular parts `r_a × d`, `r_b × d` and the same premultiplied by the inverse world
@@ -114,11 +113,29 @@ impl PairConstraint for ContactConstraint {
     }
 }
 
-/// Builds the constraints of the manifolds that touch an awake dynamic body, already in
-/// colour order (module `coloring`), and returns them with the colour ranges. `impulse_in`
-/// scales the stored impulses (per-step units) to the solver's units (0 disables warm
-/// start). The manifolds are coloured first and each constraint is built once, at its
-/// place: no reordering copy of the (large) constraints.
+/// The contact constraints of a step and the buffers that build them, owned by the world and
+/// reused from step to step (cleared, not freed): once they have grown to the scene, preparing
+/// and solving contacts allocates nothing (Box2D v3 keeps its constraints in a per-world
+/// arena for the same reason).
+#[derive(Debug, Clone, Default)]
+pub(crate) struct ContactScratch {
+    /// The constraints, in colour order.
+    pub cons: Vec<ContactConstraint>,
+    /// Constraint order and colour ranges (`ranges` index `cons`).
+    pub colouring: Colouring,
+    /// Manifold index of each selected manifold.
+    selected: Vec<usize>,
+    /// Body slots of each selected manifold.
+    pairs: Vec<(usize, usize)>,
+    colour: ColourScratch,
+}
+
+/// Builds the constraints of the manifolds that touch an awake dynamic body into
+/// `scratch.cons`, already in colour order (module `coloring`), with the colour ranges in
+/// `scratch.colouring.ranges`. `impulse_in` scales the stored impulses (per-step units) to
+/// the solver's units (0 disables warm start). The manifolds are coloured first and each
+/// constraint is built once, at its place: no reordering copy of the (large) constraints.
+/// Allocates only when a buffer of `scratch` must grow.
 pub(crate) fn prepare(
     manifolds: &[ContactManifold],
     set: &BodySet,
@@ -126,9 +143,17 @@ pub(crate) fn prepare(
     impulse_in: Real,
     soft: Softness,
     static_soft: Softness,
-) -> (Vec<ContactConstraint>, Vec<Range<usize>>) {
-    let mut selected = Vec::with_capacity(manifolds.len());
-    let mut pairs = Vec::with_capacity(manifolds.len());
+    scratch: &mut ContactScratch,
+) {
+    let ContactScratch {
+        cons,
+        colouring,
+        selected,
+        pairs,
+        colour,
+    } = scratch;
+    selected.clear();
+    pairs.clear();
     for (m_index, m) in manifolds.iter().enumerate() {
         let (a, b) = (m.body_a.index as usize, m.body_b.index as usize);
         if m.points().is_empty() || !(bodies[a].dynamic || bodies[b].dynamic) {
@@ -137,24 +162,26 @@ pub(crate) fn prepare(
         selected.push(m_index);
         pairs.push((a, b));
     }
-    let col = colour(&pairs, bodies.len(), |i| bodies[i].dynamic);
-    let cons = col
-        .order
-        .iter()
-        .map(|&k| {
-            let m_index = selected[k];
-            prepare_one(
-                &manifolds[m_index],
-                m_index,
-                set,
-                bodies,
-                impulse_in,
-                soft,
-                static_soft,
-            )
-        })
-        .collect();
-    (cons, col.ranges)
+    colour_into(
+        pairs,
+        bodies.len(),
+        |i| bodies[i].dynamic,
+        colour,
+        colouring,
+    );
+    cons.clear();
+    cons.extend(colouring.order.iter().map(|&k| {
+        let m_index = selected[k];
+        prepare_one(
+            &manifolds[m_index],
+            m_index,
+            set,
+            bodies,
+            impulse_in,
+            soft,
+            static_soft,
+        )
+    }));
 }
 
 /// The constraint of manifold `m` (index `m_index`), which touches an awake dynamic body.

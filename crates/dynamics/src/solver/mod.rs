@@ -15,6 +15,8 @@
 //! body, so a colour may be solved in parallel with rayon and still give the same bits as a
 //! sequential solve (each constraint reads and writes only its own two bodies).
 
+#[cfg(test)]
+mod alloc_tests;
 pub(crate) mod coloring;
 pub(crate) mod contact;
 pub(crate) mod joints;
@@ -24,6 +26,9 @@ pub(crate) mod soft_step;
 mod timing;
 
 pub use timing::StepTimings;
+
+/// The solver's reusable buffers, owned by the world (see [`contact::ContactScratch`]).
+pub(crate) type SolverScratch = contact::ContactScratch;
 
 use crate::body_set::BodySet;
 use crate::contact::ContactManifold;
@@ -145,6 +150,8 @@ pub(crate) struct StepContext<'a> {
     pub gyroscopic: bool,
     pub parallel: bool,
     pub timings: &'a mut StepTimings,
+    /// Reused buffers: no allocation in the solver once they have grown to the scene.
+    pub scratch: &'a mut SolverScratch,
 }
 
 /// Per-body state the solver works on (Box2D v3's `b2BodyState`), copied from the body set

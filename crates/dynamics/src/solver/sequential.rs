@@ -22,14 +22,17 @@ pub(crate) fn step(ctx: &mut StepContext) {
     lap(&mut t, &mut ctx.timings.forces);
 
     let warm = if p.warm_starting { 1.0 } else { 0.0 };
-    let (mut cons, ranges) = contact::prepare(
+    let scratch = &mut *ctx.scratch;
+    contact::prepare(
         ctx.manifolds,
         ctx.set,
         ctx.bodies,
         warm,
         Softness::RIGID,
         Softness::RIGID,
+        scratch,
     );
+    let (cons, ranges) = (&mut scratch.cons, &scratch.colouring.ranges[..]);
     let mut rows = joints::build_all(ctx.joints, ctx.set, ctx.bodies, dt, warm);
     lap(&mut t, &mut ctx.timings.prepare);
 
@@ -37,7 +40,7 @@ pub(crate) fn step(ctx: &mut StepContext) {
     let (par, min) = (ctx.parallel, p.parallel_min_batch);
     if p.warm_starting {
         joints::warm_start(&mut rows, bodies);
-        solve_coloured(&mut cons, &ranges, bodies, par, min, contact::warm_start);
+        solve_coloured(cons, ranges, bodies, par, min, contact::warm_start);
     }
     lap(&mut t, &mut ctx.timings.warm_start);
 
@@ -45,7 +48,7 @@ pub(crate) fn step(ctx: &mut StepContext) {
     let threshold = p.restitution_threshold;
     for _ in 0..p.velocity_iterations {
         joints::solve(&mut rows, bodies, joint_soft, 1.0 / dt, true, false);
-        solve_coloured(&mut cons, &ranges, bodies, par, min, |c, a, b| {
+        solve_coloured(cons, ranges, bodies, par, min, |c, a, b| {
             contact::solve_velocity_si(c, a, b, dt, threshold)
         });
     }
@@ -58,7 +61,7 @@ pub(crate) fn step(ctx: &mut StepContext) {
     }
     let (erp_over_dt, slop) = (p.split_erp / dt, p.linear_slop);
     for _ in 0..p.position_iterations {
-        solve_coloured(&mut cons, &ranges, bodies, par, min, |c, a, b| {
+        solve_coloured(cons, ranges, bodies, par, min, |c, a, b| {
             contact::solve_push_si(c, a, b, erp_over_dt, slop)
         });
     }
@@ -67,7 +70,7 @@ pub(crate) fn step(ctx: &mut StepContext) {
     integrate::integrate_positions(ctx.set, bodies, dt, true);
     lap(&mut t, &mut ctx.timings.integrate);
 
-    contact::store(&cons, ctx.manifolds, 1.0);
+    contact::store(cons, ctx.manifolds, 1.0);
     joints::store(&rows, ctx.joints, 1.0);
     lap(&mut t, &mut ctx.timings.store);
 }

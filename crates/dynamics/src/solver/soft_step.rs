@@ -34,8 +34,17 @@ pub(crate) fn step(ctx: &mut StepContext) {
         0.0
     };
     let (soft, static_soft) = contact::softness_pair(&p, h);
-    let (mut cons, ranges) =
-        contact::prepare(ctx.manifolds, ctx.set, ctx.bodies, warm, soft, static_soft);
+    let scratch = &mut *ctx.scratch;
+    contact::prepare(
+        ctx.manifolds,
+        ctx.set,
+        ctx.bodies,
+        warm,
+        soft,
+        static_soft,
+        scratch,
+    );
+    let (cons, ranges) = (&mut scratch.cons, &scratch.colouring.ranges[..]);
     let mut rows = joints::build_all(ctx.joints, ctx.set, ctx.bodies, h, warm);
     let joint_soft = Softness::new(p.joint_hertz, p.joint_damping_ratio, h);
     let (par, min) = (ctx.parallel, p.parallel_min_batch);
@@ -52,19 +61,12 @@ pub(crate) fn step(ctx: &mut StepContext) {
         }
         if p.warm_starting {
             joints::warm_start(&mut rows, ctx.bodies);
-            solve_coloured(
-                &mut cons,
-                &ranges,
-                ctx.bodies,
-                par,
-                min,
-                contact::warm_start,
-            );
+            solve_coloured(cons, ranges, ctx.bodies, par, min, contact::warm_start);
         }
         lap(&mut t, &mut ctx.timings.warm_start);
 
         joints::solve(&mut rows, ctx.bodies, joint_soft, inv_h, true, true);
-        solve_coloured(&mut cons, &ranges, ctx.bodies, par, min, |c, a, b| {
+        solve_coloured(cons, ranges, ctx.bodies, par, min, |c, a, b| {
             contact::solve_soft(c, a, b, inv_h, max_push, true)
         });
         integrate::clamp_speeds(ctx.set, ctx.bodies);
@@ -75,19 +77,19 @@ pub(crate) fn step(ctx: &mut StepContext) {
 
         joints::refresh(&mut rows, ctx.joints, ctx.set, ctx.bodies, h);
         joints::solve(&mut rows, ctx.bodies, joint_soft, inv_h, false, true);
-        solve_coloured(&mut cons, &ranges, ctx.bodies, par, min, |c, a, b| {
+        solve_coloured(cons, ranges, ctx.bodies, par, min, |c, a, b| {
             contact::solve_soft(c, a, b, inv_h, max_push, false)
         });
         lap(&mut t, &mut ctx.timings.relax);
     }
 
     let threshold = p.restitution_threshold;
-    solve_coloured(&mut cons, &ranges, ctx.bodies, par, min, |c, a, b| {
+    solve_coloured(cons, ranges, ctx.bodies, par, min, |c, a, b| {
         contact::apply_restitution(c, a, b, threshold)
     });
     lap(&mut t, &mut ctx.timings.restitution);
 
-    contact::store(&cons, ctx.manifolds, n as Real);
+    contact::store(cons, ctx.manifolds, n as Real);
     joints::store(&rows, ctx.joints, n as Real);
     lap(&mut t, &mut ctx.timings.store);
 }
