@@ -124,8 +124,9 @@ fn validate(vertices: &[Vec3], indices: &[[u32; 3]]) -> Result<()> {
             "a mesh needs at least one triangle",
         ));
     }
-    for (i, v) in vertices.iter().enumerate() {
-        check_finite_vec(&format!("vertices[{i}]"), *v)?;
+    // Name the bad vertex only on failure (no string per vertex on the hot path).
+    if let Some(i) = vertices.iter().position(|v| !v.is_finite()) {
+        check_finite_vec(&format!("vertices[{i}]"), vertices[i])?;
     }
     let n = vertices.len();
     for (t, tri) in indices.iter().enumerate() {
@@ -249,16 +250,21 @@ impl TriMesh {
     }
 }
 
-/// Bounding box of each triangle, the primitive boxes of a mesh BVH.
+/// Bounding box of each triangle, the primitive boxes of a mesh BVH (an indexed map, in
+/// parallel with the `parallel` feature; the result does not depend on the thread count).
 pub fn triangle_aabbs(vertices: &[Vec3], indices: &[[u32; 3]]) -> Vec<Aabb> {
-    indices
-        .iter()
-        .map(|t| {
-            Aabb::from_points([
-                vertices[t[0] as usize],
-                vertices[t[1] as usize],
-                vertices[t[2] as usize],
-            ])
-        })
-        .collect()
+    let aabb = |t: &[u32; 3]| {
+        Aabb::from_points([
+            vertices[t[0] as usize],
+            vertices[t[1] as usize],
+            vertices[t[2] as usize],
+        ])
+    };
+    #[cfg(feature = "parallel")]
+    {
+        use rayon::prelude::*;
+        indices.par_iter().map(aabb).collect()
+    }
+    #[cfg(not(feature = "parallel"))]
+    indices.iter().map(aabb).collect()
 }

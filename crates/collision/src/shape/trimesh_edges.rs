@@ -120,25 +120,16 @@ pub fn weld_vertices(
 ///
 /// Sort-based matching, as in Jolt's `MeshEdge` building and parry's topology pass but
 /// without a hash map: each edge becomes one `u64` key (low vertex, high vertex) beside its
-/// slot `3·t + k`, and the pairs are sorted (unique, so the order is deterministic whatever
-/// the thread count). Face normals are computed once per triangle; with the `parallel`
-/// feature the sort, the normals and the per-edge classification run on rayon, each edge
-/// writing only its own slot.
+/// slot `3·t + k`, and the pairs are sorted by a counting sort on the low vertex
+/// (`sorted_edge_keys`; unique keys, so the order is deterministic whatever the thread
+/// count). Face normals are computed once per triangle; with the `parallel` feature the
+/// normals and the per-edge classification run on rayon, each edge writing only its own slot.
 pub fn compute_edges(
     vertices: &[Vec3],
     indices: &[[u32; 3]],
     flat_angle: Real,
 ) -> Vec<[MeshEdge; 3]> {
-    let mut list: Vec<(u64, u32)> = Vec::with_capacity(indices.len() * 3);
-    for (t, tri) in indices.iter().enumerate() {
-        for k in 0..3 {
-            let (a, b) = (tri[k], tri[(k + 1) % 3]);
-            if a != b {
-                let key = (u64::from(a.min(b)) << 32) | u64::from(a.max(b));
-                list.push((key, 3 * t as u32 + k as u32));
-            }
-        }
-    }
+    let list = sorted_edge_keys(vertices.len(), indices);
     let normal = |tri: &[u32; 3]| -> Option<Vec3> {
         let [a, b, c] = tri.map(|i| vertices[i as usize]);
         (b - a).cross(c - a).try_normalize()
@@ -146,14 +137,10 @@ pub fn compute_edges(
     #[cfg(feature = "parallel")]
     let normals: Vec<Option<Vec3>> = {
         use rayon::prelude::*;
-        list.par_sort_unstable();
         indices.par_iter().map(normal).collect()
     };
     #[cfg(not(feature = "parallel"))]
-    let normals: Vec<Option<Vec3>> = {
-        list.sort_unstable();
-        indices.iter().map(normal).collect()
-    };
+    let normals: Vec<Option<Vec3>> = indices.iter().map(normal).collect();
     // The edge at sorted position `i`, if its key is shared by exactly one other slot.
     let classify = |i: usize| -> Option<(u32, MeshEdge)> {
         let key = list[i].0;
@@ -196,6 +183,52 @@ pub fn compute_edges(
         edges[(slot / 3) as usize][(slot % 3) as usize] = e;
     }
     edges
+}
+
+/// Every non-degenerate edge as `(low << 32 | high, 3·t + k)`, sorted. A counting sort on
+/// the low vertex (one pass to count, one to place, in slot order) leaves only the few
+/// edges of each vertex to sort by `(high, slot)`: linear time instead of a comparison sort
+/// of all `3·T` edges. Keys with slots are unique, so the result is fully determined.
+fn sorted_edge_keys(num_vertices: usize, indices: &[[u32; 3]]) -> Vec<(u64, u32)> {
+    let edge = |tri: &[u32; 3], k: usize| {
+        let (a, b) = (tri[k], tri[(k + 1) % 3]);
+        (a.min(b), a.max(b))
+    };
+    let mut start = vec![0u32; num_vertices + 1];
+    for tri in indices {
+        for k in 0..3 {
+            let (lo, hi) = edge(tri, k);
+            if lo != hi {
+                start[lo as usize + 1] += 1;
+            }
+        }
+    }
+    for v in 0..num_vertices {
+        start[v + 1] += start[v];
+    }
+    let total = start[num_vertices] as usize;
+    let mut list = vec![(0u64, 0u32); total];
+    let mut fill = start.clone();
+    for (t, tri) in indices.iter().enumerate() {
+        for k in 0..3 {
+            let (lo, hi) = edge(tri, k);
+            if lo != hi {
+                let at = &mut fill[lo as usize];
+                list[*at as usize] = (
+                    (u64::from(lo) << 32) | u64::from(hi),
+                    3 * t as u32 + k as u32,
+                );
+                *at += 1;
+            }
+        }
+    }
+    for v in 0..num_vertices {
+        let (a, b) = (start[v] as usize, start[v + 1] as usize);
+        if b - a > 1 {
+            list[a..b].sort_unstable();
+        }
+    }
+    list
 }
 
 /// Edge `k` of triangle `t` with neighbour `other`. When both triangles run the edge in the
