@@ -314,3 +314,42 @@ fn other_cached_shapes_are_checked_on_load() {
         );
     }
 }
+
+#[test]
+fn load_with_options_welds_like_the_constructor() {
+    let obj = "v 0 0 0\nv 1 0 0\nv 0 0 1\nv 1 0 0\nv 1 0 1\nv 0 0 1\nf 1 3 2\nf 4 6 5\n";
+    let path = std::env::temp_dir().join(format!("carom_mesh2_{}.obj", std::process::id()));
+    std::fs::write(&path, obj).unwrap();
+    let plain = TriMesh::load(&path).unwrap();
+    let options = TriMeshOptions {
+        weld_tolerance: Some(0.0),
+        ..Default::default()
+    };
+    let welded = TriMesh::load_with_options(&path, options).unwrap();
+    let bad = TriMeshOptions {
+        weld_tolerance: Some(-1.0),
+        ..Default::default()
+    };
+    let err = TriMesh::load_with_options(&path, bad).unwrap_err();
+    std::fs::remove_file(&path).unwrap();
+    assert_eq!(plain.vertices().len(), 6);
+    assert_eq!(welded.vertices().len(), 4);
+    let built = TriMesh::with_options(plain.vertices().to_vec(), plain.indices().to_vec(), options);
+    assert_eq!(welded, built.unwrap());
+    // The shared diagonal is an interior edge only after welding.
+    assert!(plain
+        .edges()
+        .iter()
+        .flatten()
+        .all(|e| e.neighbor == NO_NEIGHBOR));
+    assert_eq!(
+        welded
+            .edges()
+            .iter()
+            .flatten()
+            .filter(|e| e.neighbor != NO_NEIGHBOR)
+            .count(),
+        2
+    );
+    assert!(err.to_string().contains("weld_tolerance"), "{err}");
+}
