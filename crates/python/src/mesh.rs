@@ -310,11 +310,23 @@ impl PyTriMesh {
     }
 
     /// Loads a mesh from a `.obj` or `.stl` file (by extension, case-insensitive; OBJ
-    /// polygons are triangulated, STL duplicate vertices merged). Unreadable or malformed
-    /// files raise `CaromError`.
+    /// polygons are triangulated, STL duplicate vertices merged). With `weld_tolerance`
+    /// (finite, >= 0), vertices closer than it are merged as in the constructor. Unreadable
+    /// or malformed files and a bad tolerance raise `CaromError`.
     #[staticmethod]
-    fn load(py: Python<'_>, path: std::path::PathBuf) -> PyResult<Bound<'_, PyAny>> {
-        let mesh = py.detach(move || core(|| TriMesh::load(&path)))?;
+    #[pyo3(signature = (path, weld_tolerance = None))]
+    fn load(
+        py: Python<'_>,
+        path: std::path::PathBuf,
+        weld_tolerance: Option<f64>,
+    ) -> PyResult<Bound<'_, PyAny>> {
+        let options = TriMeshOptions {
+            weld_tolerance: weld_tolerance
+                .map(|t| scalar("weld_tolerance", t))
+                .transpose()?,
+            ..Default::default()
+        };
+        let mesh = py.detach(move || core(|| TriMesh::load_with_options(&path, options)))?;
         wrap_shape(py, Arc::new(mesh.into()))
     }
 

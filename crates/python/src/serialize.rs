@@ -7,10 +7,10 @@
 //! load bytes from untrusted sources: a maliciously deep nesting can still exhaust the stack
 //! while decoding.)
 
-use carom_collision::math::check_isometry;
+use carom_collision::math::{check_isometry, Aabb};
+use carom_collision::shape::serde_check;
 use carom_collision::shape::{
-    Capsule, Compound, Cone, ConvexHull, Cuboid, Cylinder, HeightField, Plane, Scaled, Shape,
-    Sphere, SupportMap, TriMesh, Triangle,
+    Capsule, Cone, ConvexHull, Cuboid, Cylinder, Plane, Scaled, Shape, Sphere, SupportMap, Triangle,
 };
 use carom_collision::{CaromError, Result};
 
@@ -40,8 +40,14 @@ pub fn from_bytes(data: &[u8]) -> Result<Shape> {
     let body = data
         .strip_prefix(MAGIC)
         .ok_or_else(|| parse_err("missing header: not bytes made by Shape.to_bytes()"))?;
-    let (shape, rest): (Shape, &[u8]) =
-        postcard::take_from_bytes(body).map_err(|e| parse_err(e.to_string()))?;
+    serde_check::clear_load_error();
+    let decoded: std::result::Result<(Shape, &[u8]), _> = postcard::take_from_bytes(body);
+    // A shape's own load check (core `TryFrom`) names the problem; postcard drops the
+    // message, so it is taken from where the check recorded it.
+    let (shape, rest) = decoded.map_err(|e| match serde_check::take_load_error() {
+        Some(err) => parse_err(err.to_string()),
+        None => parse_err(e.to_string()),
+    })?;
     if !rest.is_empty() {
         return Err(parse_err(format!("{} trailing bytes", rest.len())));
     }
@@ -85,10 +91,7 @@ fn validate(shape: &Shape, depth: usize) -> Result<()> {
             s,
             "cone",
         ),
-        Shape::ConvexHull(h) => match hull_problem(h) {
-            None => Ok(()),
-            Some(reason) => Err(parse_err(format!("invalid convex hull: {reason}"))),
-        },
+        Shape::ConvexHull(h) => check_bounds(&h.local_aabb(), "convex hull"),
         Shape::Triangle(t) => same(Triangle::new(t.a, t.b, t.c)?, t, "triangle"),
         Shape::Plane(p) => {
             let rebuilt = Plane::new(p.normal(), p.offset())?;
@@ -97,32 +100,16 @@ fn validate(shape: &Shape, depth: usize) -> Result<()> {
             }
             Ok(())
         }
-        Shape::TriMesh(m) => same(
-            TriMesh::new(m.vertices().to_vec(), m.indices().to_vec())?,
-            m,
-            "triangle mesh",
-        ),
-        Shape::HeightField(h) => {
-            let (dx, dz) = h.cell_size();
-            same(
-                HeightField::new(h.rows(), h.cols(), h.heights().to_vec(), dx, dz)?,
-                h,
-                "heightfield",
-            )
-        }
+        // Meshes, heightfields, hulls, scaled shapes and compounds check themselves when
+        // deserialised (core `TryFrom` impls); the bounds here are re-checked for safety.
+        Shape::TriMesh(m) => check_bounds(&m.local_aabb(), "triangle mesh"),
+        Shape::HeightField(h) => check_bounds(&h.local_aabb(), "heightfield"),
         Shape::Compound(c) => {
             for (pose, child) in c.children() {
                 check_isometry("child pose", *pose)?;
                 validate(child, depth + 1)?;
             }
-            // Rebuilding renormalises the child rotations (not bit-exact), so check validity
-            // and the cached bounds instead of equality.
-            Compound::new(c.children().to_vec())?;
-            let b = c.local_aabb();
-            if !(b.min.is_finite() && b.max.is_finite() && b.min.cmple(b.max).all()) {
-                return Err(parse_err("inconsistent compound bounds"));
-            }
-            Ok(())
+            check_bounds(&c.local_aabb(), "compound")
         }
         Shape::Scaled(s) => {
             validate(s.inner(), depth + 1)?;
@@ -132,6 +119,15 @@ fn validate(shape: &Shape, depth: usize) -> Result<()> {
                 "scaled shape",
             )
         }
+    }
+}
+
+/// Errors unless `b` is finite with `min <= max`.
+fn check_bounds(b: &Aabb, what: &str) -> Result<()> {
+    if b.min.is_finite() && b.max.is_finite() && b.min.cmple(b.max).all() {
+        Ok(())
+    } else {
+        Err(parse_err(format!("inconsistent {what} bounds")))
     }
 }
 

@@ -164,7 +164,13 @@ impl TryFrom<BvhData> for Bvh {
             Nodes::Quantized(v, _) => v.iter().map(|n| n.data).collect(),
             Nodes::Unquantized(v) => v.iter().map(|n| n.data).collect(),
         };
-        check_structure(&data, &d.order)?;
+        if let Err(reason) = check_structure(&data, &d.order) {
+            let _ = crate::shape::serde_check::record::<()>(Err(CaromError::Parse {
+                what: "BVH".into(),
+                reason: reason.clone(),
+            }));
+            return Err(reason);
+        }
         Ok(Bvh {
             wide: wide_nodes(&d.nodes),
             nodes: d.nodes,
@@ -395,6 +401,100 @@ impl Bvh {
         self.bounds = aabbs[0];
         self.nodes = make_nodes(self.layout(), &aabbs, &data, &self.bounds);
         self.wide = wide_nodes(&self.nodes);
+        Ok(())
+    }
+
+    /// Checks this hierarchy against the primitive boxes it should bound (used when a mesh
+    /// is deserialised): one primitive per box, `order` a permutation, finite bounds equal to
+    /// the union of the boxes, the leaves covering `order` in depth-first sequence (each
+    /// primitive in exactly one leaf), the quantisation the one of those bounds, and every node box
+    /// exactly the box [`Bvh::new`] or [`Bvh::refit`] gives for its subtree. Errors name the
+    /// first broken invariant.
+    pub fn check_primitives(&self, boxes: &[Aabb]) -> Result<()> {
+        let bad = |what: &str, value: String, reason: &str| {
+            Err(CaromError::invalid(format!("bvh.{what}"), value, reason))
+        };
+        if boxes.len() != self.order.len() {
+            return bad(
+                "num_primitives",
+                self.order.len().to_string(),
+                &format!("must equal the {} primitives", boxes.len()),
+            );
+        }
+        let mut seen = vec![false; boxes.len()];
+        for &p in &self.order {
+            match seen.get_mut(p as usize) {
+                Some(s) if !*s => *s = true,
+                _ => {
+                    return bad(
+                        "order",
+                        p.to_string(),
+                        "not a permutation of the primitives",
+                    )
+                }
+            }
+        }
+        if !(self.bounds.is_valid() && self.bounds.min.is_finite() && self.bounds.max.is_finite()) {
+            return bad("bounds", format!("{:?}", self.bounds), "must be finite");
+        }
+        let (_, data) = self.node_boxes_and_data();
+        // Depth-first leaves cover `order` in sequence, each primitive exactly once.
+        let mut next = 0;
+        for (i, &d) in data.iter().enumerate() {
+            if d & LEAF_FLAG != 0 {
+                let (first, count) = leaf_range(d);
+                if first != next {
+                    return bad(
+                        "leaf",
+                        i.to_string(),
+                        "leaf ranges must cover the primitives in order, once each",
+                    );
+                }
+                next = first + count;
+            }
+        }
+        if next != self.order.len() {
+            return bad(
+                "leaf",
+                next.to_string(),
+                "leaf ranges must cover the primitives in order, once each",
+            );
+        }
+        let mut aabbs = vec![Aabb::EMPTY; data.len()];
+        for i in (0..data.len()).rev() {
+            aabbs[i] = if data[i] & LEAF_FLAG != 0 {
+                let (first, count) = leaf_range(data[i]);
+                self.order[first..first + count]
+                    .iter()
+                    .fold(Aabb::EMPTY, |acc, &p| acc.merge(&boxes[p as usize]))
+            } else {
+                aabbs[i + 1].merge(&aabbs[right_child(&data, i)])
+            };
+        }
+        if aabbs[0] != self.bounds {
+            return bad(
+                "bounds",
+                format!("{:?}", self.bounds),
+                "must be the union of the primitive boxes",
+            );
+        }
+        if let Nodes::Quantized(_, q) = &self.nodes {
+            if *q != Quantization::new(&self.bounds) {
+                return bad(
+                    "quantization",
+                    format!("{q:?}"),
+                    "inconsistent with the bounds",
+                );
+            }
+        }
+        let expected = make_nodes(self.layout(), &aabbs, &data, &self.bounds);
+        if expected != self.nodes {
+            return bad(
+                "nodes",
+                format!("{} nodes", data.len()),
+                "a node box does not match its primitives",
+            );
+        }
         Ok(())
     }
 

@@ -34,7 +34,7 @@ struct CompoundData {
 impl TryFrom<CompoundData> for Compound {
     type Error = CaromError;
     fn try_from(d: CompoundData) -> Result<Self> {
-        Compound::new(d.children)
+        super::serde_check::record(Compound::new(d.children))
     }
 }
 

@@ -4,7 +4,7 @@ use super::mass::polyhedron_mass_properties;
 use super::quickhull::{quickhull, HullPolygons};
 use super::support::SupportMap;
 use super::MassProperties;
-use crate::error::Result;
+use crate::error::{CaromError, Result};
 use crate::math::{check_finite_vec, Aabb, Mat3, Real, Vec3};
 use serde::{Deserialize, Serialize};
 
@@ -29,7 +29,11 @@ pub struct HullFace {
 ///
 /// It also stores each vertex's neighbours along the edges, for hill-climbing support queries
 /// (above [`ConvexHull::HILL_CLIMB_MIN_VERTICES`] vertices) and later for contact generation.
+///
+/// Deserialising checks the stored data (see [`ConvexHullData`]), so corrupted or
+/// inconsistent bytes give a [`CaromError`] instead of a panic in a support query.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "ConvexHullData")]
 pub struct ConvexHull {
     vertices: Vec<Vec3>,
     faces: Vec<HullFace>,
@@ -45,6 +49,100 @@ pub struct ConvexHull {
     volume: Real,
     /// Boxed to keep `Shape` small.
     unit_mass: Box<MassProperties>,
+}
+
+/// The serialised form of a [`ConvexHull`], checked on load by `TryFrom`: at least 4
+/// finite vertices, at least 4 faces of at least 3 in-range vertex indices, and every derived
+/// table (planes, edges, edge faces, adjacency, triangles, bounds, mass) equal to the one
+/// rebuilt from the vertices and face loops, with a positive volume.
+#[derive(Deserialize)]
+pub struct ConvexHullData {
+    vertices: Vec<Vec3>,
+    faces: Vec<HullFace>,
+    face_vertex_indices: Vec<u32>,
+    edges: Vec<[u32; 2]>,
+    edge_faces: Vec<[u32; 2]>,
+    neighbor_offsets: Vec<u32>,
+    neighbors: Vec<u32>,
+    triangles: Vec<[u32; 3]>,
+    local_aabb: Aabb,
+    volume: Real,
+    unit_mass: Box<MassProperties>,
+}
+
+impl TryFrom<ConvexHullData> for ConvexHull {
+    type Error = CaromError;
+    fn try_from(d: ConvexHullData) -> Result<Self> {
+        super::serde_check::record(check_hull_data(d))
+    }
+}
+
+fn check_hull_data(d: ConvexHullData) -> Result<ConvexHull> {
+    let bad = |name: &str, value: usize, reason: &str| {
+        Err(CaromError::invalid(
+            format!("convex hull {name}"),
+            value,
+            reason,
+        ))
+    };
+    let nv = d.vertices.len();
+    if nv < 4 {
+        return bad("vertices.len()", nv, "a hull needs at least 4 vertices");
+    }
+    for (i, v) in d.vertices.iter().enumerate() {
+        check_finite_vec(&format!("vertices[{i}]"), *v)?;
+    }
+    if d.faces.len() < 4 {
+        return bad(
+            "faces.len()",
+            d.faces.len(),
+            "a hull needs at least 4 faces",
+        );
+    }
+    let mut loops = Vec::with_capacity(d.faces.len());
+    for (i, f) in d.faces.iter().enumerate() {
+        let end = u64::from(f.first) + u64::from(f.count);
+        if f.count < 3 || end > d.face_vertex_indices.len() as u64 {
+            return bad("face", i, "fewer than 3 vertices or a range out of bounds");
+        }
+        let poly = &d.face_vertex_indices[f.first as usize..end as usize];
+        if let Some(&v) = poly.iter().find(|&&v| v as usize >= nv) {
+            return bad("face vertex index", v as usize, "out of range");
+        }
+        loops.push(poly.to_vec());
+    }
+    let rebuilt = ConvexHull::from_polygons(HullPolygons {
+        vertices: d.vertices.clone(),
+        faces: loops,
+    });
+    let stored = ConvexHull {
+        vertices: d.vertices,
+        faces: d.faces,
+        face_vertex_indices: d.face_vertex_indices,
+        edges: d.edges,
+        edge_faces: d.edge_faces,
+        neighbor_offsets: d.neighbor_offsets,
+        neighbors: d.neighbors,
+        triangles: d.triangles,
+        local_aabb: d.local_aabb,
+        volume: d.volume,
+        unit_mass: d.unit_mass,
+    };
+    if rebuilt != stored {
+        return bad(
+            "data",
+            stored.faces.len(),
+            "derived tables inconsistent with the faces",
+        );
+    }
+    if !(stored.volume.is_finite() && stored.volume > 0.0) {
+        return Err(CaromError::invalid(
+            "convex hull volume",
+            stored.volume,
+            "must be finite and > 0",
+        ));
+    }
+    Ok(stored)
 }
 
 impl ConvexHull {

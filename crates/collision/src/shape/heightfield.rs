@@ -13,7 +13,11 @@ use serde::{Deserialize, Serialize};
 /// triangles `2·(r·(cols-1) + c)` and `+1`, both facing +Y:
 /// `[p(r,c), p(r+1,c), p(r,c+1)]` and `[p(r,c+1), p(r+1,c), p(r+1,c+1)]`.
 /// Like Bullet's `btHeightfieldTerrainShape` and parry's `HeightField`.
+///
+/// Deserialising rebuilds the cached bounds through [`HeightField::new`] and checks them, so
+/// inconsistent bytes give a [`CaromError`].
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "HeightFieldData")]
 pub struct HeightField {
     rows: usize,
     cols: usize,
@@ -21,6 +25,35 @@ pub struct HeightField {
     dx: Real,
     dz: Real,
     local_aabb: Aabb,
+}
+
+/// The serialised form of a [`HeightField`], checked on load by `TryFrom` (the
+/// constructor's checks, and the stored bounds must be the rebuilt ones).
+#[derive(Deserialize)]
+pub struct HeightFieldData {
+    rows: usize,
+    cols: usize,
+    heights: Vec<Real>,
+    dx: Real,
+    dz: Real,
+    local_aabb: Aabb,
+}
+
+impl TryFrom<HeightFieldData> for HeightField {
+    type Error = CaromError;
+    fn try_from(d: HeightFieldData) -> Result<Self> {
+        super::serde_check::record((|| {
+            let h = HeightField::new(d.rows, d.cols, d.heights, d.dx, d.dz)?;
+            if h.local_aabb != d.local_aabb {
+                return Err(CaromError::invalid(
+                    "local_aabb",
+                    d.local_aabb,
+                    "inconsistent with the heights",
+                ));
+            }
+            Ok(h)
+        })())
+    }
 }
 
 impl HeightField {

@@ -150,14 +150,20 @@ impl TriMesh {
     /// A mesh from a `.obj` or `.stl` file, chosen by extension (case-insensitive), with
     /// default options.
     pub fn load(path: impl AsRef<Path>) -> Result<TriMesh> {
+        Self::load_with_options(path, TriMeshOptions::default())
+    }
+
+    /// A mesh from a `.obj` or `.stl` file (see [`TriMesh::load`]) with options, e.g. a
+    /// `weld_tolerance` to merge the duplicate vertices of split faces.
+    pub fn load_with_options(path: impl AsRef<Path>, options: TriMeshOptions) -> Result<TriMesh> {
         let path = path.as_ref();
         let ext = path
             .extension()
             .and_then(|e| e.to_str())
             .map(|e| e.to_ascii_lowercase());
         match ext.as_deref() {
-            Some("obj") => Self::from_obj_file(path, TriMeshOptions::default()),
-            Some("stl") => Self::from_stl_file(path, TriMeshOptions::default()),
+            Some("obj") => Self::from_obj_file(path, options),
+            Some("stl") => Self::from_stl_file(path, options),
             _ => Err(parse_err(
                 &path.display().to_string(),
                 "unknown mesh format: expected a .obj or .stl file",

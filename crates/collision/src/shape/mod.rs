@@ -19,6 +19,7 @@ mod quickhull;
 mod quickhull_builder;
 mod quickhull_merge;
 mod scaled;
+pub mod serde_check;
 mod sphere;
 mod support;
 mod triangle;

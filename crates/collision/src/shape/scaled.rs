@@ -12,11 +12,40 @@ use std::sync::Arc;
 /// `s_{SK}(d) = S · s_K(S d)` for the diagonal `S`.
 ///
 /// The margin is zero (a scaled sphere is an ellipsoid, not a point plus a radius).
+///
+/// Deserialising rebuilds it through [`Scaled::new`] and checks the result equals the stored
+/// data, so inconsistent bytes give a [`CaromError`].
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "ScaledData")]
 pub struct Scaled {
     inner: Arc<Shape>,
     scale: Vec3,
     local_aabb: Aabb,
+}
+
+/// The serialised form of a [`Scaled`], checked on load by `TryFrom`.
+#[derive(Deserialize)]
+pub struct ScaledData {
+    inner: Arc<Shape>,
+    scale: Vec3,
+    local_aabb: Aabb,
+}
+
+impl TryFrom<ScaledData> for Scaled {
+    type Error = CaromError;
+    fn try_from(d: ScaledData) -> Result<Self> {
+        super::serde_check::record((|| {
+            let s = Scaled::new(d.inner.clone(), d.scale)?;
+            if s.inner != d.inner || s.scale != d.scale || s.local_aabb != d.local_aabb {
+                return Err(CaromError::invalid(
+                    "scaled shape",
+                    d.scale,
+                    "inconsistent stored data (nested scaling or bounds)",
+                ));
+            }
+            Ok(s)
+        })())
+    }
 }
 
 impl Scaled {

@@ -34,7 +34,11 @@ impl Default for TriMeshOptions {
 /// A triangle mesh: vertices and counter-clockwise index triples, with a BVH and edge
 /// adjacency built at construction. Degenerate (zero-area) triangles are kept; they never
 /// produce NaN in queries.
+///
+/// Deserialising checks the stored data against its own triangles (see [`TriMeshData`]), so
+/// corrupted or inconsistent bytes give a [`CaromError`] instead of a failure in a query.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "TriMeshData")]
 pub struct TriMesh {
     vertices: Vec<Vec3>,
     indices: Vec<[u32; 3]>,
@@ -42,6 +46,67 @@ pub struct TriMesh {
     bvh: Bvh,
     edges: Vec<[MeshEdge; 3]>,
     flat_angle: Real,
+}
+
+/// The serialised form of a [`TriMesh`], checked on load by `TryFrom`: the vertices and
+/// indices pass the constructor's checks, the flat angle is finite and >= 0, the BVH bounds
+/// exactly the triangles ([`Bvh::check_primitives`]: primitive count, leaf ranges,
+/// quantisation, node boxes), the cached bounds are the BVH's, and the edge table equals the
+/// one computed from the triangles.
+#[derive(Deserialize)]
+pub struct TriMeshData {
+    vertices: Vec<Vec3>,
+    indices: Vec<[u32; 3]>,
+    local_aabb: Aabb,
+    bvh: Bvh,
+    edges: Vec<[MeshEdge; 3]>,
+    flat_angle: Real,
+}
+
+impl TryFrom<TriMeshData> for TriMesh {
+    type Error = CaromError;
+    fn try_from(d: TriMeshData) -> Result<Self> {
+        super::serde_check::record(check_data(d))
+    }
+}
+
+fn check_data(d: TriMeshData) -> Result<TriMesh> {
+    {
+        validate(&d.vertices, &d.indices)?;
+        check_non_negative("flat_angle", d.flat_angle)?;
+        d.bvh
+            .check_primitives(&triangle_aabbs(&d.vertices, &d.indices))?;
+        if d.local_aabb != d.bvh.root_aabb() {
+            return Err(CaromError::invalid(
+                "local_aabb",
+                d.local_aabb,
+                "must equal the bounds of the triangles",
+            ));
+        }
+        if d.edges.len() != d.indices.len() {
+            return Err(CaromError::invalid(
+                "edges.len()",
+                d.edges.len(),
+                format!("must equal the {} triangles", d.indices.len()),
+            ));
+        }
+        let expected = compute_edges(&d.vertices, &d.indices, d.flat_angle);
+        if let Some(t) = (0..expected.len()).find(|&t| expected[t] != d.edges[t]) {
+            return Err(CaromError::invalid(
+                format!("edges[{t}]"),
+                d.edges[t],
+                "inconsistent with the triangles",
+            ));
+        }
+        Ok(TriMesh {
+            vertices: d.vertices,
+            indices: d.indices,
+            local_aabb: d.local_aabb,
+            bvh: d.bvh,
+            edges: d.edges,
+            flat_angle: d.flat_angle,
+        })
+    }
 }
 
 fn validate(vertices: &[Vec3], indices: &[[u32; 3]]) -> Result<()> {
@@ -59,8 +124,9 @@ fn validate(vertices: &[Vec3], indices: &[[u32; 3]]) -> Result<()> {
             "a mesh needs at least one triangle",
         ));
     }
-    for (i, v) in vertices.iter().enumerate() {
-        check_finite_vec(&format!("vertices[{i}]"), *v)?;
+    // Name the bad vertex only on failure (no string per vertex on the hot path).
+    if let Some(i) = vertices.iter().position(|v| !v.is_finite()) {
+        check_finite_vec(&format!("vertices[{i}]"), vertices[i])?;
     }
     let n = vertices.len();
     for (t, tri) in indices.iter().enumerate() {
@@ -184,16 +250,21 @@ impl TriMesh {
     }
 }
 
-/// Bounding box of each triangle, the primitive boxes of a mesh BVH.
+/// Bounding box of each triangle, the primitive boxes of a mesh BVH (an indexed map, in
+/// parallel with the `parallel` feature; the result does not depend on the thread count).
 pub fn triangle_aabbs(vertices: &[Vec3], indices: &[[u32; 3]]) -> Vec<Aabb> {
-    indices
-        .iter()
-        .map(|t| {
-            Aabb::from_points([
-                vertices[t[0] as usize],
-                vertices[t[1] as usize],
-                vertices[t[2] as usize],
-            ])
-        })
-        .collect()
+    let aabb = |t: &[u32; 3]| {
+        Aabb::from_points([
+            vertices[t[0] as usize],
+            vertices[t[1] as usize],
+            vertices[t[2] as usize],
+        ])
+    };
+    #[cfg(feature = "parallel")]
+    {
+        use rayon::prelude::*;
+        indices.par_iter().map(aabb).collect()
+    }
+    #[cfg(not(feature = "parallel"))]
+    indices.iter().map(aabb).collect()
 }

@@ -117,72 +117,118 @@ pub fn weld_vertices(
 /// indices (weld first to match by position); an edge shared by exactly two triangles gets
 /// both as neighbours, any other count gives boundaries. `flat_angle` (radians) is the
 /// tolerance of [`EdgeKind::Flat`].
+///
+/// Sort-based matching, as in Jolt's `MeshEdge` building and parry's topology pass but
+/// without a hash map: each edge becomes one `u64` key (low vertex, high vertex) beside its
+/// slot `3·t + k`, and the pairs are sorted by a counting sort on the low vertex
+/// (`sorted_edge_keys`; unique keys, so the order is deterministic whatever the thread
+/// count). Face normals are computed once per triangle; with the `parallel` feature the
+/// normals and the per-edge classification run on rayon, each edge writing only its own slot.
 pub fn compute_edges(
     vertices: &[Vec3],
     indices: &[[u32; 3]],
     flat_angle: Real,
 ) -> Vec<[MeshEdge; 3]> {
-    // (low vertex, high vertex, triangle, edge), sorted: equal keys become adjacent.
-    let mut list: Vec<(u32, u32, u32, u8)> = Vec::with_capacity(indices.len() * 3);
-    for (t, tri) in indices.iter().enumerate() {
-        for k in 0..3 {
-            let (a, b) = (tri[k], tri[(k + 1) % 3]);
-            if a != b {
-                list.push((a.min(b), a.max(b), t as u32, k as u8));
-            }
-        }
-    }
-    // Keys are unique (they include the triangle and edge), so the order is deterministic.
-    #[cfg(feature = "parallel")]
-    rayon::slice::ParallelSliceMut::par_sort_unstable(&mut list[..]);
-    #[cfg(not(feature = "parallel"))]
-    list.sort_unstable();
-    let normal = |t: u32| -> Option<Vec3> {
-        let tri = indices[t as usize];
+    let list = sorted_edge_keys(vertices.len(), indices);
+    let normal = |tri: &[u32; 3]| -> Option<Vec3> {
         let [a, b, c] = tri.map(|i| vertices[i as usize]);
         (b - a).cross(c - a).try_normalize()
     };
+    #[cfg(feature = "parallel")]
+    let normals: Vec<Option<Vec3>> = {
+        use rayon::prelude::*;
+        indices.par_iter().map(normal).collect()
+    };
+    #[cfg(not(feature = "parallel"))]
+    let normals: Vec<Option<Vec3>> = indices.iter().map(normal).collect();
+    // The edge at sorted position `i`, if its key is shared by exactly one other slot.
+    let classify = |i: usize| -> Option<(u32, MeshEdge)> {
+        let key = list[i].0;
+        let prev = i > 0 && list[i - 1].0 == key;
+        let next = i + 1 < list.len() && list[i + 1].0 == key;
+        let partner = match (prev, next) {
+            (true, false) if i < 2 || list[i - 2].0 != key => i - 1,
+            (false, true) if i + 2 >= list.len() || list[i + 2].0 != key => i + 1,
+            _ => return None,
+        };
+        let (slot, other_slot) = (list[i].1, list[partner].1);
+        let (t, k) = (slot / 3, (slot % 3) as usize);
+        let (t2, k2) = (other_slot / 3, (other_slot % 3) as usize);
+        if t == t2 {
+            return None;
+        }
+        let same_dir = indices[t as usize][k] == indices[t2 as usize][k2];
+        let e = edge_info(
+            vertices,
+            indices,
+            normals[t as usize],
+            normals[t2 as usize],
+            t,
+            k,
+            t2,
+            same_dir,
+            flat_angle,
+        );
+        Some((slot, e))
+    };
+    #[cfg(feature = "parallel")]
+    let found: Vec<Option<(u32, MeshEdge)>> = {
+        use rayon::prelude::*;
+        (0..list.len()).into_par_iter().map(classify).collect()
+    };
+    #[cfg(not(feature = "parallel"))]
+    let found: Vec<Option<(u32, MeshEdge)>> = (0..list.len()).map(classify).collect();
     let mut edges = vec![[BOUNDARY; 3]; indices.len()];
-    let mut i = 0;
-    while i < list.len() {
-        let mut j = i + 1;
-        while j < list.len() && list[j].0 == list[i].0 && list[j].1 == list[i].1 {
-            j += 1;
-        }
-        if j - i == 2 {
-            let (t1, k1) = (list[i].2, list[i].3 as usize);
-            let (t2, k2) = (list[i + 1].2, list[i + 1].3 as usize);
-            if t1 != t2 {
-                let same_dir = indices[t1 as usize][k1] == indices[t2 as usize][k2];
-                let e1 = edge_info(
-                    vertices,
-                    indices,
-                    normal(t1),
-                    normal(t2),
-                    t1,
-                    k1,
-                    t2,
-                    same_dir,
-                    flat_angle,
-                );
-                let e2 = edge_info(
-                    vertices,
-                    indices,
-                    normal(t2),
-                    normal(t1),
-                    t2,
-                    k2,
-                    t1,
-                    same_dir,
-                    flat_angle,
-                );
-                edges[t1 as usize][k1] = e1;
-                edges[t2 as usize][k2] = e2;
-            }
-        }
-        i = j;
+    for (slot, e) in found.into_iter().flatten() {
+        edges[(slot / 3) as usize][(slot % 3) as usize] = e;
     }
     edges
+}
+
+/// Every non-degenerate edge as `(low << 32 | high, 3·t + k)`, sorted. A counting sort on
+/// the low vertex (one pass to count, one to place, in slot order) leaves only the few
+/// edges of each vertex to sort by `(high, slot)`: linear time instead of a comparison sort
+/// of all `3·T` edges. Keys with slots are unique, so the result is fully determined.
+fn sorted_edge_keys(num_vertices: usize, indices: &[[u32; 3]]) -> Vec<(u64, u32)> {
+    let edge = |tri: &[u32; 3], k: usize| {
+        let (a, b) = (tri[k], tri[(k + 1) % 3]);
+        (a.min(b), a.max(b))
+    };
+    let mut start = vec![0u32; num_vertices + 1];
+    for tri in indices {
+        for k in 0..3 {
+            let (lo, hi) = edge(tri, k);
+            if lo != hi {
+                start[lo as usize + 1] += 1;
+            }
+        }
+    }
+    for v in 0..num_vertices {
+        start[v + 1] += start[v];
+    }
+    let total = start[num_vertices] as usize;
+    let mut list = vec![(0u64, 0u32); total];
+    let mut fill = start.clone();
+    for (t, tri) in indices.iter().enumerate() {
+        for k in 0..3 {
+            let (lo, hi) = edge(tri, k);
+            if lo != hi {
+                let at = &mut fill[lo as usize];
+                list[*at as usize] = (
+                    (u64::from(lo) << 32) | u64::from(hi),
+                    3 * t as u32 + k as u32,
+                );
+                *at += 1;
+            }
+        }
+    }
+    for v in 0..num_vertices {
+        let (a, b) = (start[v] as usize, start[v + 1] as usize);
+        if b - a > 1 {
+            list[a..b].sort_unstable();
+        }
+    }
+    list
 }
 
 /// Edge `k` of triangle `t` with neighbour `other`. When both triangles run the edge in the
