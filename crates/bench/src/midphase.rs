@@ -2,7 +2,9 @@
 //! second on the landscape mesh and a generated ~1M-triangle mesh, beside parry3d's `TriMesh`
 //! on the same meshes and rays in the same run (single thread and all threads).
 //!
-//! Single-thread figures are thread CPU time (robust on a shared machine). Batch rays
+//! Build and single-thread ray figures are process CPU time: robust on a shared machine, and
+//! it counts work that construction hands to rayon workers (thread CPU time would hide it and
+//! flatter a parallel build against parry's serial one). Batch rays
 //! (`TriMesh::raycast_batch`, and parry through rayon) run in a 1-thread and an all-threads
 //! rayon pool, interleaved: their wall times give the speed-up (bounded by the cores that
 //! are free), their process CPU times the parallel overhead (1.0 = none).
@@ -47,26 +49,14 @@ fn parse_args(args: &[String]) -> Args {
     a
 }
 
-/// CPU time of the calling thread in seconds: on a loaded machine it counts only the time
-/// this thread actually ran, unlike wall time.
-fn thread_cpu_seconds() -> f64 {
-    let mut ts = libc::timespec {
-        tv_sec: 0,
-        tv_nsec: 0,
-    };
-    // SAFETY: `ts` is a valid, writable timespec; the clock id is a constant of libc.
-    unsafe { libc::clock_gettime(libc::CLOCK_THREAD_CPUTIME_ID, &mut ts) };
-    ts.tv_sec as f64 + ts.tv_nsec as f64 * 1e-9
-}
-
-/// Median single-thread CPU time in seconds of `runs` calls of `f`.
+/// Median CPU time of the whole process (all threads) in seconds of `runs` calls of `f`.
 fn median_time<T>(runs: usize, mut f: impl FnMut() -> T) -> (f64, T) {
     let mut times = Vec::new();
     let mut last = None;
     for _ in 0..runs {
-        let t0 = thread_cpu_seconds();
+        let t0 = process_cpu_seconds();
         let out = f();
-        times.push(thread_cpu_seconds() - t0);
+        times.push(process_cpu_seconds() - t0);
         last = Some(out);
     }
     times.sort_by(|a, b| a.total_cmp(b));
