@@ -100,6 +100,8 @@ impl DynamicsWorld {
             joints,
             params,
             solver_bodies: Vec::new(),
+            // Per-step buffers only (rebuilt every step): a restored world starts empty.
+            solver_scratch: SolverScratch::default(),
         })
     }
 
