@@ -23,6 +23,10 @@ use crate::shape::{ConvexRef, SupportMap};
 /// Relative tolerance of the check, applied to the smaller shape's size.
 pub const GUARD_REL_TOL: Real = 2.0e-5;
 
+/// Separated answers farther apart than this fraction of the smaller shape's size are not
+/// checked by [`guarded_separated`].
+pub const SEPARATED_CHECK_FRAC: Real = 0.05;
+
 /// Smallest half-diagonal of the two shapes' local boxes (the "small size" of the pair).
 fn small_size(a: ConvexRef<'_>, b: ConvexRef<'_>) -> Real {
     let sa = a.local_aabb().half_extents().length();
@@ -175,7 +179,8 @@ pub fn guarded_contact(
     }
 }
 
-/// The guard for a separated answer (GJK's): `c` when consistent, else the fallback when
+/// The guard for a separated answer (GJK's): `c` when farther than
+/// [`SEPARATED_CHECK_FRAC`] of the smaller shape or consistent, else the fallback when
 /// both shapes are polyhedra (the separating-axis answer) or when the fallback's distance
 /// exceeds `c`'s (a separation measured exactly along a direction is a lower bound of the
 /// true distance, so `c` was too short), else `c`.
@@ -185,7 +190,11 @@ pub fn guarded_separated(
     pose_ab: &Isometry,
     c: Contact,
 ) -> Contact {
-    if contact_is_consistent(a, b, pose_ab, &c) {
+    // Only near contact (within 5 % of the smaller shape) is GJK's answer checked: that is
+    // where its scale-relative tolerances bite, and farther pairs keep GJK's cost.
+    if c.distance > SEPARATED_CHECK_FRAC * small_size(a, b)
+        || contact_is_consistent(a, b, pose_ab, &c)
+    {
         return c;
     }
     match fallback_contact(a, b, pose_ab, Some(&c)) {
