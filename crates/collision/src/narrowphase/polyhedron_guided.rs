@@ -9,9 +9,10 @@ use crate::query::contact_cuboid_cuboid::{
 };
 use crate::query::epa::epa;
 use crate::query::gjk::{gjk, GjkResult};
+use crate::query::guard::contact_is_consistent;
 use crate::query::support_adapters::{Support, Transformed};
 use crate::query::{contact_convex, Contact};
-use crate::shape::{ConvexRef, Cuboid, SupportMap};
+use crate::shape::{ConvexRef, Cuboid};
 use smallvec::SmallVec;
 
 /// The feature id of a single GJK/EPA point.
@@ -101,12 +102,10 @@ pub fn polyhedron_manifold_guided(
     let Some(c) = contact_convex(ca, cb, pose_ab, prediction) else {
         return;
     };
-    // The shapes' exact separation along the returned normal must be the returned
-    // distance; when it is not (EPA on a degenerate polytope, e.g. shapes touching within
-    // round-off), run the full separating-axis test instead.
-    let n = c.normal;
-    let sep = n.dot(cb.support_world(pose_ab, -n)) - n.dot(ca.support(n));
-    if !(sep - c.distance).is_finite() || (sep - c.distance).abs() > 1.0e-4 * (1.0 + sep.abs()) {
+    // The shared guard of the queries: the shapes' exact separation along the returned
+    // normal must be the returned distance; when it is not (EPA on a degenerate polytope,
+    // e.g. shapes touching within round-off), run the full separating-axis test instead.
+    if !contact_is_consistent(ca, cb, pose_ab, &c) {
         polyhedron_manifold_into(a, b, pose_ab, prediction, out);
         return;
     }

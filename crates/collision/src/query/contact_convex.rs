@@ -15,6 +15,7 @@ use super::contact_round::{
 };
 use super::epa::{epa, epa_polytope};
 use super::gjk::{gjk, gjk_intersects, GjkResult};
+use super::guard::{guarded_contact, guarded_separated};
 use super::result::Contact;
 use super::support_adapters::{core_radius, AddRadius, Core, Transformed};
 use crate::math::{Isometry, Real, Vec3};
@@ -87,12 +88,13 @@ pub fn contact_gjk_epa(
                 return None;
             }
             let n = (point_b - point_a) / distance;
-            Some(Contact {
+            let c = Contact {
                 distance: signed,
                 point_a: point_a + n * ra,
                 point_b: point_b - n * rb,
                 normal: n,
-            })
+            };
+            Some(guarded_separated(a, b, pose_ab, c)).filter(|c| c.distance <= prediction)
         }
         GjkResult::Overlapping(simplex) => {
             let pen = if radius > 0.0 {
@@ -120,16 +122,15 @@ pub fn contact_gjk_epa(
                 (p, 0.0, 0.0)
             });
             let depth = pen.depth + ra + rb;
-            if -depth > prediction {
-                return None;
-            }
             let n = pen.normal;
-            Some(Contact {
+            let raw = Contact {
                 distance: -depth,
                 point_a: pen.point_a + n * ra,
                 point_b: pen.point_b - n * rb,
                 normal: n,
-            })
+            };
+            // EPA is checked against the support functions and replaced when wrong.
+            guarded_contact(a, b, pose_ab, Some(raw)).filter(|c| c.distance <= prediction)
         }
     }
 }

@@ -11,6 +11,7 @@
 use super::closest_points::closest_points_segment_segment;
 use super::contact_convex::contact_gjk_epa;
 use super::gjk::{gjk, GjkResult};
+use super::guard::guarded_separated;
 use super::result::Contact;
 use super::support_adapters::{Core, Transformed};
 use crate::math::{Isometry, Mat3, Real, Vec3, EPSILON};
@@ -134,12 +135,18 @@ pub fn cuboid_cuboid_sat(
                     distance,
                     point_a,
                     point_b,
-                } => (distance <= prediction).then(|| Contact {
-                    distance,
-                    point_a,
-                    point_b,
-                    normal: (point_b - point_a) / distance,
-                }),
+                } => {
+                    let c = Contact {
+                        distance,
+                        point_a,
+                        point_b,
+                        normal: (point_b - point_a) / distance,
+                    };
+                    // f32 GJK against a much larger box stops early (see `query::guard`).
+                    let c =
+                        guarded_separated(ConvexRef::Cuboid(a), ConvexRef::Cuboid(b), pose_ab, c);
+                    (c.distance <= prediction).then_some(c)
+                }
                 // A separating axis exists, yet GJK counts the boxes as overlapping: they touch
                 // within round-off, where EPA's polytope is degenerate (it reported depths of
                 // metres in the polytope oracle). GJK's witnesses are the touching points and

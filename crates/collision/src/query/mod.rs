@@ -29,6 +29,7 @@
 
 pub mod epa;
 pub mod gjk;
+pub mod guard;
 pub mod result;
 pub mod simplex;
 pub mod support_adapters;
