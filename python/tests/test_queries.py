@@ -100,6 +100,21 @@ def test_contact_and_intersects() -> None:
     assert not carom.intersects(s, pose([0, 0, 0]), s, pose([2.1, 0, 0]))
 
 
+def test_contact_small_box_just_above_huge_ground() -> None:
+    """A 1 m box 0.2 mm above a 250x50x250 ground box (and hull), far from the origin: the
+    answer is the gap along +Y (GJK alone called it touching in f32)."""
+    ground = carom.Box([250.0, 50.0, 250.0])
+    corners = [[sx * 250.0, sy * 50.0, sz * 250.0] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)]
+    small = carom.ConvexHull([[sx * 0.5, sy * 0.5, sz * 0.5] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)])
+    gap = 2e-4
+    for g in (ground, carom.ConvexHull(corners)):
+        for off in (0.0, 700.0):
+            c = carom.contact(g, pose([off, -50.0, 0.0]), small, pose([off + 20.0, 0.5 + gap, 0.0]), prediction=0.01)
+            assert c is not None
+            assert c.distance == pytest.approx(gap, abs=1e-4)
+            np.testing.assert_allclose(c.normal, [0, 1, 0], atol=1e-3)
+
+
 def test_batch_equals_single() -> None:
     rng = np.random.default_rng(5)
     a, b = carom.Box([0.5, 0.4, 0.3]), carom.Sphere(0.5)
