@@ -100,6 +100,7 @@ impl DynamicsWorld {
             joints,
             params,
             solver_bodies: Vec::new(),
+            solver_scratch: SolverScratch::default(),
         })
     }
 
