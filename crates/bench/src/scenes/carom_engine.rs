@@ -30,6 +30,8 @@ pub fn build(scene: &Scene, config: EngineConfig) -> Result<Box<dyn Engine>, Str
     let mut params = PipelineParams::default();
     params.dynamics.sleep.enabled = config.sleeping;
     params.dynamics.parallel = config.threads > 1;
+    // `CAROM_SOLVER_SIMD=off` selects the scalar contact solve (to measure the SIMD one).
+    params.dynamics.solver.simd = std::env::var("CAROM_SOLVER_SIMD").map_or(true, |v| v != "off");
     let world = World::from_scene_with(scene, params).map_err(|e| e.to_string())?;
     let handles = world.handles();
     let dynamic = scene

@@ -123,6 +123,8 @@ pub(crate) struct ContactScratch {
     pub cons: Vec<ContactConstraint>,
     /// Constraint order and colour ranges (`ranges` index `cons`).
     pub colouring: Colouring,
+    /// The constraints grouped four-wide for the SIMD solve (module `contact_simd`).
+    pub wide: super::contact_simd::WideScratch,
     /// Manifold index of each selected manifold.
     selected: Vec<usize>,
     /// Body slots of each selected manifold.
@@ -151,6 +153,7 @@ pub(crate) fn prepare(
         selected,
         pairs,
         colour,
+        ..
     } = scratch;
     selected.clear();
     pairs.clear();

@@ -19,6 +19,7 @@
 mod alloc_tests;
 pub(crate) mod coloring;
 pub(crate) mod contact;
+pub(crate) mod contact_simd;
 pub(crate) mod joints;
 pub(crate) mod rows;
 pub(crate) mod sequential;
@@ -82,6 +83,10 @@ pub struct SolverParams {
     pub warm_starting: bool,
     /// Smallest colour solved in parallel (when the `parallel` feature is on).
     pub parallel_min_batch: usize,
+    /// Soft step: solve the contacts of each colour four at a time with SIMD lanes
+    /// (module `contact_simd`, after Box2D v3); the overflow colour stays scalar. Both paths
+    /// give the same physics.
+    pub simd: bool,
 }
 
 impl Default for SolverParams {
@@ -102,6 +107,7 @@ impl Default for SolverParams {
             restitution_threshold: 1.0,
             warm_starting: true,
             parallel_min_batch: 256,
+            simd: true,
         }
     }
 }

@@ -10,10 +10,13 @@
 //! stored per step outside.
 
 use super::coloring::solve_coloured;
+use super::contact::ContactConstraint;
+use super::contact_simd::WideScratch;
 use super::timing::lap;
-use super::{contact, joints, Softness, StepContext};
+use super::{contact, contact_simd, joints, Softness, SolverBody, StepContext};
 use crate::integrate;
 use carom_collision::math::{Real, Vec3};
+use std::ops::Range;
 use std::time::Instant;
 
 /// Runs one step of the soft-step solver.
@@ -44,7 +47,20 @@ pub(crate) fn step(ctx: &mut StepContext) {
         static_soft,
         scratch,
     );
-    let (cons, ranges) = (&mut scratch.cons, &scratch.colouring.ranges[..]);
+    let simd = p.simd;
+    if simd {
+        contact_simd::build(
+            &scratch.cons,
+            &scratch.colouring.ranges,
+            ctx.bodies,
+            &mut scratch.wide,
+        );
+    }
+    let (cons, ranges, wide) = (
+        &mut scratch.cons,
+        &scratch.colouring.ranges[..],
+        &mut scratch.wide,
+    );
     let mut rows = joints::build_all(ctx.joints, ctx.set, ctx.bodies, h, warm);
     let joint_soft = Softness::new(p.joint_hertz, p.joint_damping_ratio, h);
     let (par, min) = (ctx.parallel, p.parallel_min_batch);
@@ -61,14 +77,19 @@ pub(crate) fn step(ctx: &mut StepContext) {
         }
         if p.warm_starting {
             joints::warm_start(&mut rows, ctx.bodies);
-            solve_coloured(cons, ranges, ctx.bodies, par, min, contact::warm_start);
+            if simd {
+                let b = &mut *ctx.bodies;
+                let (w, s) = (contact_simd::warm_start, contact::warm_start);
+                contact_simd::solve(wide, cons, b, par, min, w, s);
+            } else {
+                solve_coloured(cons, ranges, ctx.bodies, par, min, contact::warm_start);
+            }
         }
         lap(&mut t, &mut ctx.timings.warm_start);
 
         joints::solve(&mut rows, ctx.bodies, joint_soft, inv_h, true, true);
-        solve_coloured(cons, ranges, ctx.bodies, par, min, |c, a, b| {
-            contact::solve_soft(c, a, b, inv_h, max_push, true)
-        });
+        let solve = (inv_h, max_push, true);
+        solve_contacts(simd, wide, cons, ranges, ctx.bodies, (par, min), solve);
         integrate::clamp_speeds(ctx.set, ctx.bodies);
         lap(&mut t, &mut ctx.timings.solve);
 
@@ -77,19 +98,60 @@ pub(crate) fn step(ctx: &mut StepContext) {
 
         joints::refresh(&mut rows, ctx.joints, ctx.set, ctx.bodies, h);
         joints::solve(&mut rows, ctx.bodies, joint_soft, inv_h, false, true);
-        solve_coloured(cons, ranges, ctx.bodies, par, min, |c, a, b| {
-            contact::solve_soft(c, a, b, inv_h, max_push, false)
-        });
+        let relax = (inv_h, max_push, false);
+        solve_contacts(simd, wide, cons, ranges, ctx.bodies, (par, min), relax);
         lap(&mut t, &mut ctx.timings.relax);
     }
 
     let threshold = p.restitution_threshold;
-    solve_coloured(cons, ranges, ctx.bodies, par, min, |c, a, b| {
-        contact::apply_restitution(c, a, b, threshold)
-    });
+    if simd {
+        contact_simd::solve(
+            wide,
+            cons,
+            ctx.bodies,
+            par,
+            min,
+            |c, a, b| contact_simd::apply_restitution(c, a, b, threshold),
+            |c, a, b| contact::apply_restitution(c, a, b, threshold),
+        );
+        contact_simd::write_back(wide, cons);
+    } else {
+        solve_coloured(cons, ranges, ctx.bodies, par, min, |c, a, b| {
+            contact::apply_restitution(c, a, b, threshold)
+        });
+    }
     lap(&mut t, &mut ctx.timings.restitution);
 
     contact::store(cons, ctx.manifolds, n as Real);
     joints::store(&rows, ctx.joints, n as Real);
     lap(&mut t, &mut ctx.timings.store);
+}
+
+/// One soft contact pass (`(inv_h, max_push, use_bias)`) over every colour: four-wide with
+/// SIMD when `simd` (the overflow colour scalar), else scalar; `(parallel, min_batch)` as
+/// in [`solve_coloured`].
+fn solve_contacts(
+    simd: bool,
+    wide: &mut WideScratch,
+    cons: &mut [ContactConstraint],
+    ranges: &[Range<usize>],
+    bodies: &mut [SolverBody],
+    (par, min): (bool, usize),
+    (inv_h, max_push, use_bias): (Real, Real, bool),
+) {
+    if simd {
+        contact_simd::solve(
+            wide,
+            cons,
+            bodies,
+            par,
+            min,
+            |c, a, b| contact_simd::solve_soft(c, a, b, inv_h, max_push, use_bias),
+            |c, a, b| contact::solve_soft(c, a, b, inv_h, max_push, use_bias),
+        );
+    } else {
+        solve_coloured(cons, ranges, bodies, par, min, |c, a, b| {
+            contact::solve_soft(c, a, b, inv_h, max_push, use_bias)
+        });
+    }
 }

@@ -1,0 +1,576 @@
+//! Four-wide SIMD contact solve for the soft step, after Box2D v3's `contact_solver.c`
+//! (`b2ContactConstraintSIMD`, `b2GatherBodies`, `b2ScatterBodies`,
+//! `b2SolveContactTwoPointsTask`).
+//!
+//! Inside one colour no two constraints share a dynamic body, so four consecutive
+//! constraints of a colour can be solved at once: their data is transposed into one
+//! structure-of-arrays [`WideConstraint`] (lane `l` = constraint `l`; a short group is padded
+//! with empty lanes whose rows have zero mass), the velocities of their bodies are gathered
+//! into lanes, the rows are solved with `wide` vectors, and the velocities of the dynamic
+//! bodies are scattered back (static and kinematic bodies, which several lanes may share,
+//! are read but never written). The overflow colour, whose constraints may share bodies,
+//! stays on the scalar path.
+//!
+//! Every lane computes exactly the arithmetic of the scalar routines in module `contact`
+//! (same operations in the same order, no fused multiply-add), so both paths give the same
+//! physics; the grouping depends only on the colour order, never on the thread count.
+//! The lane type is selected from [`Real`] in one place ([`W`]): `f32x4` or `f64x4`.
+
+use super::coloring::{solve_coloured, COLOURS};
+use super::contact::ContactConstraint;
+use super::SolverBody;
+use crate::contact::MAX_MANIFOLD_POINTS;
+use carom_collision::math::{Real, Vec3};
+use std::ops::Range;
+
+/// Maps a scalar type to its four-lane vector.
+pub(crate) trait Lanes {
+    /// Four lanes of `Self`.
+    type W;
+}
+
+impl Lanes for f32 {
+    type W = wide::f32x4;
+}
+
+impl Lanes for f64 {
+    type W = wide::f64x4;
+}
+
+/// Four lanes of [`Real`]: `wide::f32x4` in the f32 build, `wide::f64x4` in the f64 build.
+pub(crate) type W = <Real as Lanes>::W;
+
+/// Lanes per wide constraint.
+pub(crate) const LANES: usize = 4;
+
+/// Lane body slot of a padding lane.
+const NONE: usize = usize::MAX;
+
+/// A vector of four lanes of [`Vec3`].
+#[derive(Debug, Clone, Copy, Default)]
+struct V3 {
+    x: W,
+    y: W,
+    z: W,
+}
+
+impl V3 {
+    /// Lane `l` is `f(l)`.
+    #[inline]
+    fn from_fn(f: impl Fn(usize) -> Vec3) -> V3 {
+        let v: [Vec3; LANES] = std::array::from_fn(f);
+        V3 {
+            x: W::new(v.map(|v| v.x)),
+            y: W::new(v.map(|v| v.y)),
+            z: W::new(v.map(|v| v.z)),
+        }
+    }
+
+    /// Same order of operations as glam's `Vec3::dot`.
+    #[inline(always)]
+    fn dot(self, o: V3) -> W {
+        self.x * o.x + self.y * o.y + self.z * o.z
+    }
+
+    #[inline(always)]
+    fn sub(self, o: V3) -> V3 {
+        V3 {
+            x: self.x - o.x,
+            y: self.y - o.y,
+            z: self.z - o.z,
+        }
+    }
+
+    #[inline(always)]
+    fn add(self, o: V3) -> V3 {
+        V3 {
+            x: self.x + o.x,
+            y: self.y + o.y,
+            z: self.z + o.z,
+        }
+    }
+
+    #[inline(always)]
+    fn scale(self, s: W) -> V3 {
+        V3 {
+            x: self.x * s,
+            y: self.y * s,
+            z: self.z * s,
+        }
+    }
+}
+
+/// Lane `l` is `f(l)`.
+#[inline]
+fn lanes(f: impl Fn(usize) -> Real) -> W {
+    W::new(std::array::from_fn(f))
+}
+
+/// Four [`super::contact::ContactRow`]s.
+#[derive(Debug, Clone, Copy, Default)]
+struct WideRow {
+    ang_a: V3,
+    ang_b: V3,
+    inv_ang_a: V3,
+    inv_ang_b: V3,
+    mass: W,
+}
+
+impl WideRow {
+    /// `J v`, as `ContactRow::velocity`.
+    #[inline(always)]
+    fn velocity(&self, d: V3, a: &WideBody, b: &WideBody) -> W {
+        d.dot(b.v.sub(a.v)) + self.ang_b.dot(b.w) - self.ang_a.dot(a.w)
+    }
+
+    /// `J Δx`, as `ContactRow::displacement`.
+    #[inline(always)]
+    fn displacement(&self, d: V3, a: &WideBody, b: &WideBody) -> W {
+        d.dot(b.dp.sub(a.dp)) + self.ang_b.dot(b.dq) - self.ang_a.dot(a.dq)
+    }
+
+    /// As `ContactRow::apply`.
+    #[inline(always)]
+    fn apply(&self, d: V3, lambda: W, a: &mut WideBody, b: &mut WideBody) {
+        a.v = a.v.sub(d.scale(lambda * a.inv_m));
+        a.w = a.w.sub(self.inv_ang_a.scale(lambda));
+        b.v = b.v.add(d.scale(lambda * b.inv_m));
+        b.w = b.w.add(self.inv_ang_b.scale(lambda));
+    }
+}
+
+/// Point `k` of four constraints (zero rows in lanes with fewer points).
+#[derive(Debug, Clone, Copy, Default)]
+struct WidePoint {
+    normal_row: WideRow,
+    tangent_rows: [WideRow; 2],
+    separation: W,
+    relative_velocity: W,
+    normal_impulse: W,
+    tangent_impulse: [W; 2],
+    max_normal_impulse: W,
+}
+
+/// Four contact constraints of one colour in structure-of-arrays form (Box2D v3's
+/// `b2ContactConstraintSIMD`).
+#[derive(Debug, Clone)]
+pub(crate) struct WideConstraint {
+    /// Body slots of each lane (`NONE` for padding).
+    a: [usize; LANES],
+    b: [usize; LANES],
+    /// Index of each lane's constraint in the scalar constraints (`NONE` for padding).
+    source: [usize; LANES],
+    inv_m_a: W,
+    inv_m_b: W,
+    normal: V3,
+    tangent: [V3; 2],
+    friction: W,
+    restitution: W,
+    bias_rate: W,
+    mass_scale: W,
+    impulse_scale: W,
+    points: [WidePoint; MAX_MANIFOLD_POINTS],
+    /// Largest point count of the lanes.
+    len: usize,
+}
+
+/// The velocities and position deltas of four bodies (Box2D v3's `b2BodyStateW`).
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct WideBody {
+    v: V3,
+    w: V3,
+    dp: V3,
+    dq: V3,
+    inv_m: W,
+}
+
+/// Gathers the bodies of `slots` into lanes (`b2GatherBodies`); padding lanes are a
+/// motionless static body.
+#[inline]
+fn gather(bodies: &[SolverBody], slots: &[usize; LANES], inv_m: W) -> WideBody {
+    // Twelve scalars per lane (v, w, dp, dq), transposed into twelve lane vectors.
+    let mut t = [[0.0 as Real; LANES]; 12];
+    for (l, &s) in slots.iter().enumerate() {
+        if s == NONE {
+            continue;
+        }
+        let b = &bodies[s];
+        for (k, v) in [b.v, b.w, b.dp, b.dq].iter().enumerate() {
+            t[3 * k][l] = v.x;
+            t[3 * k + 1][l] = v.y;
+            t[3 * k + 2][l] = v.z;
+        }
+    }
+    let v3 = |k: usize| V3 {
+        x: W::new(t[3 * k]),
+        y: W::new(t[3 * k + 1]),
+        z: W::new(t[3 * k + 2]),
+    };
+    WideBody {
+        v: v3(0),
+        w: v3(1),
+        dp: v3(2),
+        dq: v3(3),
+        inv_m,
+    }
+}
+
+/// Writes the velocities of the dynamic bodies of `slots` back (`b2ScatterBodies`).
+///
+/// # Safety
+/// `bodies` points to `len` solver bodies, and no other live reference touches the dynamic
+/// bodies of `slots` during the call (the colouring guarantees it for one colour).
+#[inline]
+unsafe fn scatter(body: &WideBody, bodies: *mut SolverBody, len: usize, slots: &[usize; LANES]) {
+    let [vx, vy, vz] = [body.v.x, body.v.y, body.v.z].map(|x| x.to_array());
+    let [wx, wy, wz] = [body.w.x, body.w.y, body.w.z].map(|x| x.to_array());
+    for (l, &s) in slots.iter().enumerate() {
+        if s == NONE {
+            continue;
+        }
+        assert!(s < len);
+        let target = &mut *bodies.add(s);
+        if target.dynamic {
+            target.v = Vec3::new(vx[l], vy[l], vz[l]);
+            target.w = Vec3::new(wx[l], wy[l], wz[l]);
+        }
+    }
+}
+
+impl WideConstraint {
+    /// Transposes the constraints `cons[group]` (at most four, one colour) into lanes.
+    fn new(cons: &[ContactConstraint], group: Range<usize>, bodies: &[SolverBody]) -> Self {
+        debug_assert!(group.len() <= LANES);
+        let source: [usize; LANES] = std::array::from_fn(|l| {
+            if l < group.len() {
+                group.start + l
+            } else {
+                NONE
+            }
+        });
+        let con = |l: usize| (source[l] != NONE).then(|| &cons[source[l]]);
+        let real = |f: fn(&ContactConstraint) -> Real| lanes(|l| con(l).map_or(0.0, f));
+        let vec =
+            |f: &dyn Fn(&ContactConstraint) -> Vec3| V3::from_fn(|l| con(l).map_or(Vec3::ZERO, f));
+        let a = source.map(|s| if s == NONE { NONE } else { cons[s].a });
+        let b = source.map(|s| if s == NONE { NONE } else { cons[s].b });
+        let inv_m = |slots: &[usize; LANES]| {
+            lanes(|l| {
+                if slots[l] == NONE {
+                    0.0
+                } else {
+                    bodies[slots[l]].inv_m
+                }
+            })
+        };
+        let mut points = [WidePoint::default(); MAX_MANIFOLD_POINTS];
+        for (k, wp) in points.iter_mut().enumerate() {
+            let pt = |l: usize| con(l).filter(|c| k < c.len).map(|c| &c.points[k]);
+            let row = |f: fn(&super::contact::PointConstraint) -> &super::contact::ContactRow| {
+                let r = |l: usize| pt(l).map(f);
+                WideRow {
+                    ang_a: V3::from_fn(|l| r(l).map_or(Vec3::ZERO, |r| r.ang_a)),
+                    ang_b: V3::from_fn(|l| r(l).map_or(Vec3::ZERO, |r| r.ang_b)),
+                    inv_ang_a: V3::from_fn(|l| r(l).map_or(Vec3::ZERO, |r| r.inv_ang_a)),
+                    inv_ang_b: V3::from_fn(|l| r(l).map_or(Vec3::ZERO, |r| r.inv_ang_b)),
+                    mass: lanes(|l| r(l).map_or(0.0, |r| r.mass)),
+                }
+            };
+            let val =
+                |f: fn(&super::contact::PointConstraint) -> Real| lanes(|l| pt(l).map_or(0.0, f));
+            *wp = WidePoint {
+                normal_row: row(|p| &p.normal_row),
+                tangent_rows: [row(|p| &p.tangent_rows[0]), row(|p| &p.tangent_rows[1])],
+                separation: val(|p| p.separation),
+                relative_velocity: val(|p| p.relative_velocity),
+                normal_impulse: val(|p| p.normal_impulse),
+                tangent_impulse: [val(|p| p.tangent_impulse[0]), val(|p| p.tangent_impulse[1])],
+                max_normal_impulse: val(|p| p.max_normal_impulse),
+            };
+        }
+        WideConstraint {
+            a,
+            b,
+            source,
+            inv_m_a: inv_m(&a),
+            inv_m_b: inv_m(&b),
+            normal: vec(&|c| c.normal),
+            tangent: [vec(&|c| c.tangent[0]), vec(&|c| c.tangent[1])],
+            friction: real(|c| c.friction),
+            restitution: real(|c| c.restitution),
+            bias_rate: real(|c| c.softness.bias_rate),
+            mass_scale: real(|c| c.softness.mass_scale),
+            impulse_scale: real(|c| c.softness.impulse_scale),
+            points,
+            len: (0..LANES)
+                .filter_map(|l| con(l).map(|c| c.len))
+                .max()
+                .unwrap_or(0),
+        }
+    }
+
+    /// Copies the accumulated impulses of every lane back into its scalar constraint.
+    fn write_back(&self, cons: &mut [ContactConstraint]) {
+        for (l, &s) in self.source.iter().enumerate() {
+            if s == NONE {
+                continue;
+            }
+            let c = &mut cons[s];
+            for (k, p) in c.points[..c.len].iter_mut().enumerate() {
+                let wp = &self.points[k];
+                p.normal_impulse = wp.normal_impulse.to_array()[l];
+                p.tangent_impulse = [
+                    wp.tangent_impulse[0].to_array()[l],
+                    wp.tangent_impulse[1].to_array()[l],
+                ];
+                p.max_normal_impulse = wp.max_normal_impulse.to_array()[l];
+            }
+        }
+    }
+}
+
+/// The wide constraints of a step, reused from step to step (cleared, not freed).
+#[derive(Debug, Clone, Default)]
+pub(crate) struct WideScratch {
+    /// Wide constraints, colour after colour.
+    pub cons: Vec<WideConstraint>,
+    /// Range of `cons` of each colour (overflow excluded).
+    pub ranges: Vec<Range<usize>>,
+    /// The overflow colour, as a range of the scalar constraints.
+    pub overflow: Range<usize>,
+}
+
+/// Groups the constraints of each colour (`ranges`, the last being the overflow colour) four
+/// at a time, in colour order, into `out`. Allocates only when a buffer must grow.
+pub(crate) fn build(
+    cons: &[ContactConstraint],
+    ranges: &[Range<usize>],
+    bodies: &[SolverBody],
+    out: &mut WideScratch,
+) {
+    out.cons.clear();
+    out.ranges.clear();
+    let Some((overflow, colours)) = ranges.split_last() else {
+        out.overflow = 0..0;
+        return;
+    };
+    debug_assert!(colours.len() <= COLOURS);
+    for r in colours {
+        let start = out.cons.len();
+        let mut k = r.start;
+        while k < r.end {
+            let end = (k + LANES).min(r.end);
+            out.cons.push(WideConstraint::new(cons, k..end, bodies));
+            k = end;
+        }
+        out.ranges.push(start..out.cons.len());
+    }
+    out.overflow = overflow.clone();
+}
+
+/// Copies the impulses of the wide constraints back into `cons` (before `contact::store`).
+pub(crate) fn write_back(wide: &WideScratch, cons: &mut [ContactConstraint]) {
+    for w in &wide.cons {
+        w.write_back(cons);
+    }
+}
+
+/// Raw access to the solver bodies while one colour is solved.
+#[derive(Clone, Copy)]
+struct Bodies {
+    ptr: *mut SolverBody,
+    len: usize,
+}
+
+// SAFETY: used only to solve the wide constraints of one colour, which write disjoint
+// dynamic bodies (the colouring guarantees it) and never write non-dynamic ones.
+unsafe impl Send for Bodies {}
+unsafe impl Sync for Bodies {}
+
+impl Bodies {
+    /// Gathers, runs `f` and scatters one wide constraint.
+    ///
+    /// # Safety
+    /// No other live reference may touch the dynamic bodies of `c` during the call.
+    #[inline(always)]
+    unsafe fn run<F>(self, c: &mut WideConstraint, f: &F)
+    where
+        F: Fn(&mut WideConstraint, &mut WideBody, &mut WideBody),
+    {
+        let all = std::slice::from_raw_parts(self.ptr as *const SolverBody, self.len);
+        let mut a = gather(all, &c.a, c.inv_m_a);
+        let mut b = gather(all, &c.b, c.inv_m_b);
+        f(c, &mut a, &mut b);
+        scatter(&a, self.ptr, self.len, &c.a);
+        scatter(&b, self.ptr, self.len, &c.b);
+    }
+}
+
+/// Runs `wide_fn` on every wide constraint, colour by colour (in parallel inside a colour of
+/// at least `min_batch` constraints when `parallel`), then `scalar_fn` on the overflow
+/// colour of `cons`. Same bits whatever the thread count; no allocation.
+pub(crate) fn solve<F, S>(
+    wide: &mut WideScratch,
+    cons: &mut [ContactConstraint],
+    bodies: &mut [SolverBody],
+    parallel: bool,
+    min_batch: usize,
+    wide_fn: F,
+    scalar_fn: S,
+) where
+    F: Fn(&mut WideConstraint, &mut WideBody, &mut WideBody) + Sync,
+    S: Fn(&mut ContactConstraint, &mut SolverBody, &mut SolverBody) + Sync,
+{
+    for r in &wide.ranges {
+        let chunk = &mut wide.cons[r.clone()];
+        let shared = Bodies {
+            ptr: bodies.as_mut_ptr(),
+            len: bodies.len(),
+        };
+        let go_parallel = parallel && chunk.len() * LANES >= min_batch.max(2);
+        if go_parallel && solve_parallel(chunk, shared, &wide_fn) {
+            continue;
+        }
+        for c in chunk.iter_mut() {
+            // SAFETY: `shared` is the only access to `bodies` here; one constraint at a time.
+            unsafe { shared.run(c, &wide_fn) };
+        }
+    }
+    let overflow = wide.overflow.clone();
+    solve_coloured(cons, &[overflow], bodies, false, min_batch, scalar_fn);
+}
+
+#[cfg(feature = "parallel")]
+fn solve_parallel<F>(chunk: &mut [WideConstraint], shared: Bodies, f: &F) -> bool
+where
+    F: Fn(&mut WideConstraint, &mut WideBody, &mut WideBody) + Sync,
+{
+    use rayon::prelude::*;
+    if rayon::current_num_threads() < 2 {
+        return false;
+    }
+    // SAFETY: the wide constraints of one colour share no dynamic body, so the parallel
+    // calls write disjoint bodies; non-dynamic bodies are only read.
+    chunk
+        .par_iter_mut()
+        .with_min_len(16)
+        .for_each(|c| unsafe { shared.run(c, f) });
+    true
+}
+
+#[cfg(not(feature = "parallel"))]
+fn solve_parallel<F>(_: &mut [WideConstraint], _: Bodies, _: &F) -> bool {
+    false
+}
+
+/// Warm start, as `contact::warm_start` in every lane.
+pub(crate) fn warm_start(c: &mut WideConstraint, a: &mut WideBody, b: &mut WideBody) {
+    let [tx, ty] = c.tangent;
+    for p in &c.points[..c.len] {
+        let (ni, [ti0, ti1]) = (p.normal_impulse, p.tangent_impulse);
+        let imp = c.normal.scale(ni).add(tx.scale(ti0)).add(ty.scale(ti1));
+        let (r, [t0, t1]) = (&p.normal_row, &p.tangent_rows);
+        a.v = a.v.sub(imp.scale(a.inv_m));
+        a.w = a.w.sub(
+            r.inv_ang_a
+                .scale(ni)
+                .add(t0.inv_ang_a.scale(ti0))
+                .add(t1.inv_ang_a.scale(ti1)),
+        );
+        b.v = b.v.add(imp.scale(b.inv_m));
+        b.w = b.w.add(
+            r.inv_ang_b
+                .scale(ni)
+                .add(t0.inv_ang_b.scale(ti0))
+                .add(t1.inv_ang_b.scale(ti1)),
+        );
+    }
+}
+
+/// Coulomb friction, as `contact::solve_friction` in every lane.
+#[inline(always)]
+fn solve_friction(c: &mut WideConstraint, a: &mut WideBody, b: &mut WideBody) {
+    let [t0, t1] = c.tangent;
+    let one = W::splat(1.0);
+    for p in c.points[..c.len].iter_mut() {
+        let [r0, r1] = &p.tangent_rows;
+        let old = p.tangent_impulse;
+        let new = [
+            old[0] - r0.mass * r0.velocity(t0, a, b),
+            old[1] - r1.mass * r1.velocity(t1, a, b),
+        ];
+        let max = c.friction * p.normal_impulse;
+        let len_sq = new[0] * new[0] + new[1] * new[1];
+        // Lanes inside the cone keep `new` (scale exactly 1); the others are projected.
+        let scale = len_sq.simd_gt(max * max).select(max / len_sq.sqrt(), one);
+        let new = [new[0] * scale, new[1] * scale];
+        p.tangent_impulse = new;
+        r0.apply(t0, new[0] - old[0], a, b);
+        r1.apply(t1, new[1] - old[1], a, b);
+    }
+}
+
+/// Soft-step solve (`b2SolveContactTwoPointsTask`), as `contact::solve_soft` in every lane:
+/// friction, then the normal rows with soft feedback when `use_bias` (relax otherwise).
+pub(crate) fn solve_soft(
+    c: &mut WideConstraint,
+    a: &mut WideBody,
+    b: &mut WideBody,
+    inv_h: Real,
+    max_push: Real,
+    use_bias: bool,
+) {
+    solve_friction(c, a, b);
+    let (zero, one) = (W::splat(0.0), W::splat(1.0));
+    let (inv_h, min_bias) = (W::splat(inv_h), W::splat(-max_push));
+    let n = c.normal;
+    for p in c.points[..c.len].iter_mut() {
+        let row = &p.normal_row;
+        let s = p.separation + row.displacement(n, a, b);
+        let gap = s.simd_gt(zero);
+        let (bias, mass_scale, impulse_scale) = if use_bias {
+            (
+                gap.select(s * inv_h, (c.bias_rate * s).max(min_bias)),
+                gap.select(one, c.mass_scale),
+                gap.select(zero, c.impulse_scale),
+            )
+        } else {
+            (gap.select(s * inv_h, zero), one, zero)
+        };
+        let vn = row.velocity(n, a, b);
+        let lambda = -row.mass * mass_scale * (vn + bias) - impulse_scale * p.normal_impulse;
+        let new = (p.normal_impulse + lambda).max(zero);
+        row.apply(n, new - p.normal_impulse, a, b);
+        p.normal_impulse = new;
+        p.max_normal_impulse = p.max_normal_impulse.max(new);
+    }
+}
+
+/// Restitution pass (`b2ApplyRestitution`), as `contact::apply_restitution` in every lane:
+/// lanes that did not approach faster than `threshold`, carried no impulse or have no
+/// restitution are left unchanged.
+pub(crate) fn apply_restitution(
+    c: &mut WideConstraint,
+    a: &mut WideBody,
+    b: &mut WideBody,
+    threshold: Real,
+) {
+    let zero = W::splat(0.0);
+    let threshold = W::splat(-threshold);
+    let bouncy = !c.restitution.simd_eq(zero);
+    let n = c.normal;
+    for p in c.points[..c.len].iter_mut() {
+        let skip = p.relative_velocity.simd_gt(threshold) | p.max_normal_impulse.simd_eq(zero);
+        let active = bouncy & !skip;
+        let row = &p.normal_row;
+        let vn = row.velocity(n, a, b);
+        let lambda = -row.mass * (vn + c.restitution * p.relative_velocity);
+        let new = active.select((p.normal_impulse + lambda).max(zero), p.normal_impulse);
+        row.apply(n, new - p.normal_impulse, a, b);
+        p.normal_impulse = new;
+    }
+}
+
+#[cfg(test)]
+#[path = "contact_simd_tests.rs"]
+mod tests;
