@@ -106,11 +106,15 @@ impl PyWorld {
     /// mass from `mass` (kg, > 0) if given, else from `density` (kg/m³) and the shape's
     /// volume; `is_static` bodies never move; `kinematic` bodies move only by their
     /// velocity. `friction` (>= 0) and `restitution` (in [0, 1]) combine by product and max.
-    /// `group`/`mask` are 32-bit collision filter bits.
+    /// `group`/`mask` are 32-bit collision filter bits. `gravity_scale` multiplies the
+    /// world gravity for this body; `max_linear_speed` (m/s) and `max_angular_speed` (rad/s)
+    /// clamp its speeds after the solve; `user_data` is any 64-bit integer, read back with
+    /// `user_data(handle)`.
     #[pyo3(signature = (
         shape, pose = None, mass = None, density = 1000.0, friction = 0.5, restitution = 0.0,
         is_static = false, kinematic = false, linear_velocity = None, angular_velocity = None,
-        linear_damping = 0.0, angular_damping = 0.0, group = 1, mask = 0xFFFF_FFFF
+        linear_damping = 0.0, angular_damping = 0.0, group = 1, mask = 0xFFFF_FFFF,
+        gravity_scale = 1.0, max_linear_speed = 400.0, max_angular_speed = 100.0, user_data = 0
     ))]
     #[allow(clippy::too_many_arguments)]
     fn add_body(
@@ -129,6 +133,10 @@ impl PyWorld {
         angular_damping: f64,
         group: u32,
         mask: u32,
+        gravity_scale: f64,
+        max_linear_speed: f64,
+        max_angular_speed: f64,
+        user_data: u64,
     ) -> PyResult<u64> {
         if is_static && kinematic {
             return Err(invalid(
@@ -154,6 +162,10 @@ impl PyWorld {
             restitution: scalar("restitution", restitution)?,
             linear_damping: scalar("linear_damping", linear_damping)?,
             angular_damping: scalar("angular_damping", angular_damping)?,
+            gravity_scale: scalar("gravity_scale", gravity_scale)?,
+            max_linear_speed: scalar("max_linear_speed", max_linear_speed)?,
+            max_angular_speed: scalar("max_angular_speed", max_angular_speed)?,
+            user_data,
             filter: Filter {
                 group,
                 mask,
@@ -351,6 +363,16 @@ impl PyWorld {
     fn add_torque(&mut self, handle: u64, torque: &Bound<'_, PyAny>) -> PyResult<()> {
         let t = vec3(torque, "torque")?;
         core(|| self.world.bodies_mut().add_torque(self::handle(handle), t))
+    }
+
+    /// The `user_data` integer body `handle` was created with.
+    fn user_data(&self, handle: u64) -> PyResult<u64> {
+        core(|| {
+            self.world
+                .bodies()
+                .info(self::handle(handle))
+                .map(|i| i.user_data)
+        })
     }
 
     /// Whether body `handle` is asleep.
