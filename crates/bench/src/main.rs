@@ -4,6 +4,7 @@
 
 mod broadphase;
 mod cdtest;
+mod mesh_inputs;
 mod midphase;
 mod plot;
 mod scenes;
