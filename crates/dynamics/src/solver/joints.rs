@@ -9,7 +9,7 @@
 //! [`refresh`]es the rows in place after each position update (Box3D's split of
 //! `b3PrepareJoint` from the substep solves; module `joint::build`).
 
-use super::rows::{Block, Row};
+use super::rows::{Block, Motion, Row};
 use super::{Softness, SolverBody};
 use crate::body_set::BodySet;
 use crate::joint::{prepare_joint, refresh_joint, JointRows, JointSet, ROW_SLOTS};
@@ -65,7 +65,7 @@ pub(crate) fn refresh(
 /// Applies the accumulated impulses.
 pub(crate) fn warm_start(s: &mut JointScratch, bodies: &mut [SolverBody]) {
     for jr in &s.joints {
-        let (mut a, mut b) = (bodies[jr.a], bodies[jr.b]);
+        let (mut a, mut b) = (Motion::of(&bodies[jr.a]), Motion::of(&bodies[jr.b]));
         for row in &s.rows[jr.rows.clone()] {
             row.warm_start(&mut a, &mut b);
         }
@@ -73,13 +73,9 @@ pub(crate) fn warm_start(s: &mut JointScratch, bodies: &mut [SolverBody]) {
     }
 }
 
-fn write_back(bodies: &mut [SolverBody], jr: &JointRows, a: SolverBody, b: SolverBody) {
-    if a.dynamic {
-        bodies[jr.a] = a;
-    }
-    if b.dynamic {
-        bodies[jr.b] = b;
-    }
+fn write_back(bodies: &mut [SolverBody], jr: &JointRows, a: Motion, b: Motion) {
+    a.store(&mut bodies[jr.a]);
+    b.store(&mut bodies[jr.b]);
 }
 
 /// One pass over every row: valid blocks of equality rows together, the other rows one by
@@ -92,7 +88,7 @@ pub(crate) fn solve(
     use_bias: bool,
 ) {
     for jr in &s.joints {
-        let (mut a, mut b) = (bodies[jr.a], bodies[jr.b]);
+        let (mut a, mut b) = (Motion::of(&bodies[jr.a]), Motion::of(&bodies[jr.b]));
         let rows = &mut s.rows[jr.rows.clone()];
         let mut i = 0;
         for block in &s.blocks[jr.blocks.clone()] {

@@ -12,6 +12,38 @@
 use super::{inv_or_zero, Softness, SolverBody};
 use carom_collision::math::{Mat3, Real, Vec3};
 
+/// The part of a body that solving a row reads and writes: its velocities and inverse
+/// mass (the inverse inertia is folded into each row's `ia`/`ib`). Small, so a joint's
+/// passes copy two of these rather than two whole [`SolverBody`]s.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Motion {
+    pub v: Vec3,
+    pub w: Vec3,
+    pub inv_m: Real,
+}
+
+impl Motion {
+    /// The velocities and inverse mass of `b`.
+    #[inline]
+    pub fn of(b: &SolverBody) -> Motion {
+        Motion {
+            v: b.v,
+            w: b.w,
+            inv_m: b.inv_m,
+        }
+    }
+
+    /// Writes the velocities back into `b` when it is dynamic (the only bodies the solver
+    /// changes).
+    #[inline]
+    pub fn store(&self, b: &mut SolverBody) {
+        if b.dynamic {
+            b.v = self.v;
+            b.w = self.w;
+        }
+    }
+}
+
 /// How a row constrains its velocity.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) enum RowKind {
@@ -95,12 +127,12 @@ impl Row {
     }
 
     #[inline]
-    pub(crate) fn velocity(&self, a: &SolverBody, b: &SolverBody) -> Real {
+    pub(crate) fn velocity(&self, a: &Motion, b: &Motion) -> Real {
         self.lin_a.dot(a.v) + self.ang_a.dot(a.w) + self.lin_b.dot(b.v) + self.ang_b.dot(b.w)
     }
 
     #[inline]
-    pub(crate) fn apply(&self, a: &mut SolverBody, b: &mut SolverBody, lambda: Real) {
+    pub(crate) fn apply(&self, a: &mut Motion, b: &mut Motion, lambda: Real) {
         a.v += self.lin_a * (a.inv_m * lambda);
         a.w += self.ia * lambda;
         b.v += self.lin_b * (b.inv_m * lambda);
@@ -108,7 +140,7 @@ impl Row {
     }
 
     /// Applies the accumulated impulse.
-    pub fn warm_start(&self, a: &mut SolverBody, b: &mut SolverBody) {
+    pub fn warm_start(&self, a: &mut Motion, b: &mut Motion) {
         self.apply(a, b, self.impulse);
     }
 
@@ -118,8 +150,8 @@ impl Row {
     /// the current error.
     pub fn solve(
         &mut self,
-        a: &mut SolverBody,
-        b: &mut SolverBody,
+        a: &mut Motion,
+        b: &mut Motion,
         soft: Softness,
         inv_h: Real,
         use_bias: bool,
@@ -194,23 +226,37 @@ impl Block {
             r.ia = a.inv_i * r.ang_a;
             r.ib = b.inv_i * r.ang_b;
         }
-        let mut k = Mat3::IDENTITY;
-        for (j, rj) in rows.iter().enumerate() {
-            for (i, ri) in rows.iter().enumerate().take(j + 1) {
-                let kij = a.inv_m * ri.lin_a.dot(rj.lin_a)
+        // The six entries of the symmetric K, padded with the identity past `len`.
+        let e = |i: usize, j: usize| match (rows.get(i), rows.get(j)) {
+            (Some(ri), Some(rj)) => {
+                a.inv_m * ri.lin_a.dot(rj.lin_a)
                     + b.inv_m * ri.lin_b.dot(rj.lin_b)
                     + ri.ang_a.dot(rj.ia)
-                    + ri.ang_b.dot(rj.ib);
-                k.col_mut(j)[i] = kij;
-                k.col_mut(i)[j] = kij;
+                    + ri.ang_b.dot(rj.ib)
             }
-        }
-        let diag: Real = (0..3).map(|i| k.col(i)[i]).product();
-        let det = k.determinant();
+            _ if i == j => 1.0,
+            _ => 0.0,
+        };
+        let (k00, k01, k02) = (e(0, 0), e(0, 1), e(0, 2));
+        let (k11, k12, k22) = (e(1, 1), e(1, 2), e(2, 2));
+        // Cofactors: K⁻¹ = C / det for a symmetric K.
+        let c00 = k11 * k22 - k12 * k12;
+        let c01 = k02 * k12 - k01 * k22;
+        let c02 = k01 * k12 - k02 * k11;
+        let det = k00 * c00 + k01 * c01 + k02 * c02;
+        let diag = k00 * k11 * k22;
         // Relative conditioning test: a nearly singular K is solved row by row instead.
         self.valid = det.is_finite() && diag > 0.0 && det > 1e-4 * diag;
         if self.valid {
-            self.inv_k = k.inverse();
+            let c11 = k00 * k22 - k02 * k02;
+            let c12 = k01 * k02 - k00 * k12;
+            let c22 = k00 * k11 - k01 * k01;
+            let inv_det = 1.0 / det;
+            self.inv_k = Mat3::from_cols(
+                Vec3::new(c00, c01, c02) * inv_det,
+                Vec3::new(c01, c11, c12) * inv_det,
+                Vec3::new(c02, c12, c22) * inv_det,
+            );
         } else {
             for r in rows.iter_mut() {
                 r.finish(a, b);
@@ -223,8 +269,8 @@ impl Block {
     pub fn solve(
         &self,
         rows: &mut [Row],
-        a: &mut SolverBody,
-        b: &mut SolverBody,
+        a: &mut Motion,
+        b: &mut Motion,
         soft: Softness,
         use_bias: bool,
     ) {
