@@ -123,7 +123,7 @@ pub(crate) fn prepare_joint(
     jr.rows = row_start..rows.len();
     let own = &mut rows[jr.rows.clone()];
     for row in own.iter_mut() {
-        row.impulse = (joint.impulses[row.slot] * impulse_in).clamp(row.lo, row.hi);
+        row.impulse = (joint.impulses[row.slot as usize] * impulse_in).clamp(row.lo, row.hi);
     }
     // Runs of two or three consecutive equality rows become blocks.
     let mut i = 0;

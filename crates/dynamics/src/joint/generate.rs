@@ -45,11 +45,11 @@ impl Sink<'_> {
     /// One row for `slot` with Jacobian `j` and error `c`; `kind` gives the row kind and
     /// its motor bound, and is only evaluated when appending.
     #[inline]
-    fn put(&mut self, slot: usize, j: [Vec3; 4], c: Real, kind: impl FnOnce() -> (RowKind, Real)) {
+    fn put(&mut self, slot: usize, j: [Vec3; 3], c: Real, kind: impl FnOnce() -> (RowKind, Real)) {
         match self {
             Sink::Append(rows) => {
                 let (kind, max) = kind();
-                rows.push(Row::new(slot, j, c, kind, max));
+                rows.push(Row::new(slot as u8, j, c, kind, max));
             }
             Sink::Overwrite(rows, i) => {
                 if let Some(row) = rows.get_mut(*i) {
@@ -64,9 +64,11 @@ impl Sink<'_> {
     /// zero impulse (a row that would be absent).
     #[inline]
     fn put_inactive(&mut self, slot: usize) {
-        let zero = [Vec3::ZERO; 4];
+        let zero = [Vec3::ZERO; 3];
         match self {
-            Sink::Append(rows) => rows.push(Row::new(slot, zero, 0.0, RowKind::Inequality, 0.0)),
+            Sink::Append(rows) => {
+                rows.push(Row::new(slot as u8, zero, 0.0, RowKind::Inequality, 0.0))
+            }
             Sink::Overwrite(rows, i) => {
                 if let Some(row) = rows.get_mut(*i) {
                     row.set(zero, 0.0);
@@ -86,7 +88,7 @@ impl Sink<'_> {
         c: Real,
         kind: impl FnOnce() -> (RowKind, Real),
     ) {
-        let j = [-axis, -f.ra.cross(axis), axis, f.rb.cross(axis)];
+        let j = [axis, -f.ra.cross(axis), f.rb.cross(axis)];
         self.put(slot, j, c, kind);
     }
 
@@ -98,7 +100,7 @@ impl Sink<'_> {
         c: Real,
         kind: impl FnOnce() -> (RowKind, Real),
     ) {
-        self.put(slot, [Vec3::ZERO, -axis, Vec3::ZERO, axis], c, kind);
+        self.put(slot, [Vec3::ZERO, -axis, axis], c, kind);
     }
 }
 

@@ -140,8 +140,8 @@ fn assert_same_rows(fresh: &[Row], refreshed: &[Row], what: &str) {
         assert_eq!(x.slot, y.slot, "{what}");
         assert_eq!(x.kind, y.kind, "{what}");
         assert_eq!((x.lo, x.hi), (y.lo, y.hi), "{what}");
-        let jx = [x.lin_a, x.ang_a, x.lin_b, x.ang_b, x.ia, x.ib];
-        let jy = [y.lin_a, y.ang_a, y.lin_b, y.ang_b, y.ia, y.ib];
+        let jx = [x.lin, x.ang_a, x.ang_b, x.ia, x.ib];
+        let jy = [y.lin, y.ang_a, y.ang_b, y.ia, y.ib];
         assert_eq!(jx, jy, "{what}: slot {}", x.slot);
         assert_eq!(x.c, y.c, "{what}: slot {}", x.slot);
         assert_eq!(x.inv_k, y.inv_k, "{what}: slot {}", x.slot);

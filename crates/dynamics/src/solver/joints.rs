@@ -119,7 +119,7 @@ pub(crate) fn store(s: &JointScratch, joints: &mut JointSet, scale: Real) {
         if let Some(j) = joints.get_index_mut(jr.joint) {
             j.impulses = [0.0; ROW_SLOTS];
             for row in &s.rows[jr.rows.clone()] {
-                j.impulses[row.slot] = row.impulse * scale;
+                j.impulses[row.slot as usize] = row.impulse * scale;
             }
         }
     }

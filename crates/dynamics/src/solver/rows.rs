@@ -1,9 +1,11 @@
 //! Generic one-dimensional constraint rows, the building blocks of every joint.
 //!
-//! A row is a Jacobian `J = (lin_a, ang_a, lin_b, ang_b)` with a position error `C`, solved
+//! A row is a Jacobian `J = (−lin, ang_a, lin, ang_b)` with a position error `C`, solved
 //! as in Catto's sequential impulses: `λ = -m_eff·(J v + bias)`, accumulated and clamped.
 //! Bullet's joints (`btTypedConstraint::getInfo2`) and Box2D v3's joints are written the same
-//! way; here every joint type only *builds* rows and one routine solves them all.
+//! way; here every joint type only *builds* rows and one routine solves them all. The linear
+//! parts of both bodies are equal and opposite (a linear row pushes the bodies apart along
+//! one direction, an angular row has none), so a row keeps one `lin`.
 //!
 //! A row keeps its angular Jacobians premultiplied by the bodies' inverse world inertias
 //! (`ia`, `ib`, computed with the effective mass): the inverse inertias are fixed for the
@@ -60,9 +62,9 @@ pub(crate) enum RowKind {
 /// One prepared row.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Row {
-    pub lin_a: Vec3,
+    /// Linear Jacobian of B (A's is `-lin`).
+    pub lin: Vec3,
     pub ang_a: Vec3,
-    pub lin_b: Vec3,
     pub ang_b: Vec3,
     /// `I_a⁻¹ ang_a` and `I_b⁻¹ ang_b` (set by [`Row::finish`] or [`Block::update`]).
     pub ia: Vec3,
@@ -74,23 +76,23 @@ pub(crate) struct Row {
     pub hi: Real,
     pub impulse: Real,
     /// The joint's warm-starting slot of this row (`< ROW_SLOTS`).
-    pub slot: usize,
+    pub slot: u8,
 }
 
 impl Row {
-    /// A row for `slot` with Jacobian `J` and error `c`; bounds come from `kind` (`max` for
-    /// motors). The effective mass is set later ([`Row::finish`] or a [`Block`]).
-    pub fn new(slot: usize, j: [Vec3; 4], c: Real, kind: RowKind, max: Real) -> Row {
+    /// A row for `slot` with Jacobian `j = [lin, ang_a, ang_b]` and error `c`; bounds come
+    /// from `kind` (`max` for motors). The effective mass is set later ([`Row::finish`] or a
+    /// [`Block`]).
+    pub fn new(slot: u8, j: [Vec3; 3], c: Real, kind: RowKind, max: Real) -> Row {
         let (lo, hi) = match kind {
             RowKind::Equality | RowKind::Spring { .. } => (Real::NEG_INFINITY, Real::INFINITY),
             RowKind::Inequality => (0.0, Real::INFINITY),
             RowKind::Motor { .. } => (-max, max),
         };
         Row {
-            lin_a: j[0],
+            lin: j[0],
             ang_a: j[1],
-            lin_b: j[2],
-            ang_b: j[3],
+            ang_b: j[2],
             ia: Vec3::ZERO,
             ib: Vec3::ZERO,
             inv_k: 0.0,
@@ -106,11 +108,10 @@ impl Row {
     /// Replaces the Jacobian and the error (a refresh from new poses), keeping the kind,
     /// bounds and accumulated impulse.
     #[inline]
-    pub fn set(&mut self, j: [Vec3; 4], c: Real) {
-        self.lin_a = j[0];
+    pub fn set(&mut self, j: [Vec3; 3], c: Real) {
+        self.lin = j[0];
         self.ang_a = j[1];
-        self.lin_b = j[2];
-        self.ang_b = j[3];
+        self.ang_b = j[2];
         self.c = c;
     }
 
@@ -119,8 +120,7 @@ impl Row {
     pub fn finish(&mut self, a: &SolverBody, b: &SolverBody) {
         self.ia = a.inv_i * self.ang_a;
         self.ib = b.inv_i * self.ang_b;
-        let k = a.inv_m * self.lin_a.length_squared()
-            + b.inv_m * self.lin_b.length_squared()
+        let k = (a.inv_m + b.inv_m) * self.lin.length_squared()
             + self.ang_a.dot(self.ia)
             + self.ang_b.dot(self.ib);
         self.inv_k = inv_or_zero(k);
@@ -128,14 +128,14 @@ impl Row {
 
     #[inline]
     pub(crate) fn velocity(&self, a: &Motion, b: &Motion) -> Real {
-        self.lin_a.dot(a.v) + self.ang_a.dot(a.w) + self.lin_b.dot(b.v) + self.ang_b.dot(b.w)
+        self.lin.dot(b.v - a.v) + self.ang_a.dot(a.w) + self.ang_b.dot(b.w)
     }
 
     #[inline]
     pub(crate) fn apply(&self, a: &mut Motion, b: &mut Motion, lambda: Real) {
-        a.v += self.lin_a * (a.inv_m * lambda);
+        a.v -= self.lin * (a.inv_m * lambda);
         a.w += self.ia * lambda;
-        b.v += self.lin_b * (b.inv_m * lambda);
+        b.v += self.lin * (b.inv_m * lambda);
         b.w += self.ib * lambda;
     }
 
@@ -227,12 +227,10 @@ impl Block {
             r.ib = b.inv_i * r.ang_b;
         }
         // The six entries of the symmetric K, padded with the identity past `len`.
+        let inv_m = a.inv_m + b.inv_m;
         let e = |i: usize, j: usize| match (rows.get(i), rows.get(j)) {
             (Some(ri), Some(rj)) => {
-                a.inv_m * ri.lin_a.dot(rj.lin_a)
-                    + b.inv_m * ri.lin_b.dot(rj.lin_b)
-                    + ri.ang_a.dot(rj.ia)
-                    + ri.ang_b.dot(rj.ib)
+                inv_m * ri.lin.dot(rj.lin) + ri.ang_a.dot(rj.ia) + ri.ang_b.dot(rj.ib)
             }
             _ if i == j => 1.0,
             _ => 0.0,
