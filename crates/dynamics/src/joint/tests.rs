@@ -264,3 +264,43 @@ fn cone_rows_are_inactive_where_their_axes_are_undefined() {
     let upper = rows.iter().find(|row| row.slot == 13).unwrap();
     assert!((upper.c - 0.1).abs() < 1e-4, "twist row c = {}", upper.c);
 }
+
+#[test]
+fn a_singular_block_falls_back_to_rows_and_stays_finite() {
+    use crate::solver::joints::{solve, JointScratch};
+    use crate::solver::Softness;
+    use carom_collision::math::Mat3;
+    // A fixed joint between two bodies whose rotation the solver cannot change (zero inverse
+    // inertia): the rotation block's K is zero.
+    let mut r = rig(JointKind::Fixed, Vec3::ZERO);
+    let mut bodies = Vec::new();
+    integrate::load(&r.set, &mut bodies);
+    for b in bodies.iter_mut() {
+        b.inv_i = Mat3::ZERO;
+        b.v = Vec3::new(0.3, -0.2, 0.1);
+        b.w = Vec3::new(1.0, 2.0, -0.5);
+    }
+    moved(&mut r, Quat::from_rotation_z(0.3));
+    let (jr, rows, blocks) = prepare(&r, &bodies);
+    assert_eq!(blocks.len(), 2);
+    assert!(blocks[0].valid, "the point block has the masses");
+    assert!(!blocks[1].valid, "the rotation block is singular");
+    assert!(rows[3..].iter().all(|row| row.inv_k == 0.0));
+    let mut s = JointScratch {
+        joints: vec![jr],
+        rows,
+        blocks,
+    };
+    let soft = Softness::new(60.0, 2.0, 1.0 / 240.0);
+    let w0: Vec<Vec3> = bodies.iter().map(|b| b.w).collect();
+    for use_bias in [true, false] {
+        solve(&mut s, &mut bodies, soft, 240.0, use_bias);
+    }
+    for (b, w) in bodies.iter().zip(w0) {
+        assert!(b.v.is_finite() && b.w.is_finite());
+        assert_eq!(b.w, w, "no angular change without inverse inertia");
+    }
+    // The point rows did act.
+    assert!(s.rows[..3].iter().all(|row| row.impulse.is_finite()));
+    assert!(s.rows[..3].iter().any(|row| row.impulse != 0.0));
+}
