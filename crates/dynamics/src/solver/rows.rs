@@ -139,9 +139,12 @@ impl Row {
         b.w += self.ib * lambda;
     }
 
-    /// Applies the accumulated impulse.
+    /// Applies the accumulated impulse (nothing for a row without one, such as a limit
+    /// that was not reached).
     pub fn warm_start(&self, a: &mut Motion, b: &mut Motion) {
-        self.apply(a, b, self.impulse);
+        if self.impulse != 0.0 {
+            self.apply(a, b, self.impulse);
+        }
     }
 
     /// One sequential-impulse update. `soft` is the position feedback of equality and
@@ -178,7 +181,10 @@ impl Row {
         let new = (self.impulse + lambda).clamp(self.lo, self.hi);
         let lambda = new - self.impulse;
         self.impulse = new;
-        self.apply(a, b, lambda);
+        // A clamped row (typically a limit far from being reached) changes nothing.
+        if lambda != 0.0 {
+            self.apply(a, b, lambda);
+        }
     }
 }
 
