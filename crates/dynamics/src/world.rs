@@ -10,6 +10,7 @@ use crate::contact::ContactManifold;
 use crate::integrate;
 use crate::island::{self, SleepParams};
 use crate::joint::{JointDesc, JointHandle, JointSet};
+use crate::solver::joints::JointScratch;
 use crate::solver::{
     self, SolverBody, SolverKind, SolverParams, SolverScratch, StepContext, StepTimings,
 };
@@ -71,6 +72,8 @@ pub struct DynamicsWorld {
     solver_bodies: Vec<SolverBody>,
     /// The solver's constraint and colouring buffers, reused from step to step.
     solver_scratch: SolverScratch,
+    /// The solver's joint rows, reused from step to step.
+    joint_scratch: JointScratch,
 }
 
 impl DynamicsWorld {
@@ -83,6 +86,7 @@ impl DynamicsWorld {
             params,
             solver_bodies: Vec::new(),
             solver_scratch: SolverScratch::default(),
+            joint_scratch: JointScratch::default(),
         })
     }
 
@@ -102,6 +106,7 @@ impl DynamicsWorld {
             solver_bodies: Vec::new(),
             // Per-step buffers only (rebuilt every step): a restored world starts empty.
             solver_scratch: SolverScratch::default(),
+            joint_scratch: JointScratch::default(),
         })
     }
 
@@ -238,6 +243,7 @@ impl DynamicsWorld {
             parallel: self.params.parallel,
             timings: &mut report.timings,
             scratch: &mut self.solver_scratch,
+            joint_scratch: &mut self.joint_scratch,
         };
         match self.params.solver.kind {
             SolverKind::SequentialImpulse => solver::sequential::step(&mut ctx),

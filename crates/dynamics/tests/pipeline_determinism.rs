@@ -56,3 +56,36 @@ fn pile_is_bit_identical_on_one_and_two_threads_and_across_runs() {
     assert_eq!(one, two, "1 vs 2 threads");
     assert_eq!(two, again, "two runs");
 }
+
+/// The 136-ragdoll benchmark scene (1360 hinge and cone-twist joints), both solvers: the
+/// joint rows are prepared, refreshed and solved sequentially, the contacts in parallel.
+fn ragdoll_hash(kind: SolverKind, n_steps: usize) -> u64 {
+    let mut p = PipelineParams::default();
+    p.dynamics.solver.parallel_min_batch = 2;
+    p.dynamics.solver.kind = kind;
+    let mut w = World::from_scene_with(&carom_scenes::bullet::ragdolls(), p).unwrap();
+    let mut touched = 0;
+    for _ in 0..n_steps {
+        touched = touched.max(w.step(1.0 / 60.0).unwrap().manifolds);
+    }
+    assert!(
+        touched > 100,
+        "{kind:?}: the ragdolls never landed ({touched} manifolds)"
+    );
+    w.state_hash()
+}
+
+#[test]
+fn ragdolls_are_bit_identical_on_one_and_two_threads() {
+    let n = steps(90, 45);
+    for kind in [SolverKind::SoftStep, SolverKind::SequentialImpulse] {
+        let run = |threads: usize| {
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap()
+                .install(|| ragdoll_hash(kind, n))
+        };
+        assert_eq!(run(1), run(2), "{kind:?}: 1 vs 2 threads");
+    }
+}

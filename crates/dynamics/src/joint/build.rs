@@ -7,25 +7,49 @@
 //! the twist angle about Z for the hinge (Bullet's `getHingeAngle`), a swing–twist
 //! decomposition about X for the cone-twist joint with an elliptic swing cone
 //! (`btConeTwistConstraint`).
+//!
+//! Rows are built in two phases, as Box2D v3 / box3d split `b3PrepareJoint` from the
+//! substep solves: [`prepare_joint`] runs once per step and fixes everything that does not
+//! move — which rows exist, their kinds, bounds, slots and warm-start impulses, which runs
+//! form blocks, and the anchors and frame rotations in the bodies' centre-of-mass frames;
+//! [`refresh_joint`] runs after every position update of the soft step and only rotates the
+//! anchors and axes by the current body rotations, recomputes the errors, and updates the
+//! effective masses (with the step's fixed inverse inertias). Both run the same generator
+//! (module `generate`), which writes through a sink that either appends rows or overwrites
+//! the Jacobian and error of the next existing one, so the two cannot disagree on the row
+//! order.
 
-use super::{Axis, AxisMode, Joint, JointKind};
+use super::generate::{generate, Frames, Sink};
+use super::Joint;
 use crate::body_set::BodySet;
 use crate::solver::rows::{Block, Row, RowKind};
-use crate::solver::{Softness, SolverBody};
-use carom_collision::math::{Quat, Real, Vec3};
+use crate::solver::SolverBody;
+use carom_collision::math::{Mat3, Quat, Real, Vec3};
+use std::ops::Range;
 
 /// Row slots per joint: 6 axes × (lower/equality, upper, motor).
 pub(crate) const ROW_SLOTS: usize = 18;
 
-/// The rows of one joint this step, each with its warm-starting slot, and the runs of
-/// equality rows solved as blocks.
+/// One active joint in the step: its bodies, the ranges of its rows and blocks in the
+/// solver's joint scratch, and the per-step constants the refreshes start from.
 #[derive(Debug, Clone)]
 pub(crate) struct JointRows {
+    /// Joint slot.
     pub joint: usize,
+    /// Body slots.
     pub a: usize,
     pub b: usize,
-    pub rows: Vec<(usize, Row)>,
-    pub blocks: Vec<Block>,
+    /// The joint's rows in the shared row buffer.
+    pub rows: Range<usize>,
+    /// The joint's blocks in the shared block buffer (`start` relative to `rows.start`).
+    pub blocks: Range<usize>,
+    /// Anchor of frame A relative to A's centre of mass, in A's body axes (box3d's
+    /// `frameA.p = rot(q, f.p - localCenter)` before the rotation).
+    local_a: Vec3,
+    local_b: Vec3,
+    /// Joint frame rotations in the body frames.
+    frame_qa: Quat,
+    frame_qb: Quat,
 }
 
 /// Rotation vector (axis × angle, angle in `[0, π]`) of a unit quaternion.
@@ -39,306 +63,124 @@ pub(crate) fn rotation_vector(q: Quat) -> Vec3 {
     v * (2.0 * s.atan2(q.w) / s)
 }
 
-struct Frames {
-    ra: Vec3,
-    rb: Vec3,
-    d: Vec3,
-    rot_a: Quat,
-    rot_b: Quat,
-    q_rel: Quat,
-}
-
-impl Frames {
-    fn axis_a(&self, i: usize) -> Vec3 {
-        self.rot_a * unit(i)
+impl JointRows {
+    /// The joint frames from the bodies' current poses.
+    #[inline]
+    fn frames(&self, set: &BodySet) -> Frames {
+        let (qa, qb) = (set.rotation[self.a], set.rotation[self.b]);
+        let (pa, pb) = (set.position[self.a], set.position[self.b]);
+        let rot_a = qa * self.frame_qa;
+        let rot_b = qb * self.frame_qb;
+        let rb = qb * self.local_b;
+        let anchor_b = pb + rb;
+        let anchor_a = pa + qa * self.local_a;
+        Frames {
+            ra: anchor_b - pa,
+            rb,
+            d: anchor_b - anchor_a,
+            axes_a: Mat3::from_quat(rot_a),
+            rot_b,
+            q_rel: (rot_a.conjugate() * rot_b).normalize(),
+        }
     }
 }
 
-fn unit(i: usize) -> Vec3 {
-    [Vec3::X, Vec3::Y, Vec3::Z][i]
-}
-
-/// Builds the rows of `joint` (slot `index`) with substep `h` (for motor force bounds and
-/// spring softness). Returns `None` for broken joints or joints between non-moving bodies.
-pub(crate) fn build_rows(
+/// Builds the rows of `joint` (slot `index`) for a step with substep `h` (for motor force
+/// bounds and spring softness), appending them to `rows` and its blocks to `blocks`;
+/// stored impulses are scaled by `impulse_in`. Returns `None` (and appends nothing) for
+/// broken joints or joints between non-moving bodies.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn prepare_joint(
     index: usize,
     joint: &Joint,
     set: &BodySet,
     bodies: &[SolverBody],
     h: Real,
     impulse_in: Real,
+    rows: &mut Vec<Row>,
+    blocks: &mut Vec<Block>,
 ) -> Option<JointRows> {
     let desc = &joint.desc;
     let (a, b) = (desc.body_a.index as usize, desc.body_b.index as usize);
     if joint.broken || !(bodies[a].dynamic || bodies[b].dynamic) {
         return None;
     }
+    let row_start = rows.len();
+    let block_start = blocks.len();
     let mut jr = JointRows {
         joint: index,
         a,
         b,
-        rows: Vec::with_capacity(6),
-        blocks: Vec::with_capacity(2),
+        rows: row_start..row_start,
+        blocks: block_start..block_start,
+        local_a: desc.frame_a.translation - set.info[a].local_com,
+        local_b: desc.frame_b.translation - set.info[b].local_com,
+        frame_qa: desc.frame_a.rotation,
+        frame_qb: desc.frame_b.rotation,
     };
-    fill_rows(joint, set, bodies, h, &mut jr);
-    for (slot, row) in jr.rows.iter_mut() {
-        row.impulse = (joint.impulses[*slot] * impulse_in).clamp(row.lo, row.hi);
+    let f = jr.frames(set);
+    generate(&desc.kind, &f, h, &mut Sink::Append(rows));
+    jr.rows = row_start..rows.len();
+    let own = &mut rows[jr.rows.clone()];
+    for row in own.iter_mut() {
+        row.impulse = (joint.impulses[row.slot as usize] * impulse_in).clamp(row.lo, row.hi);
     }
+    // Runs of two or three consecutive equality rows become blocks.
+    let mut i = 0;
+    while i < own.len() {
+        let mut end = i;
+        while end < own.len() && end - i < 3 && own[end].kind == RowKind::Equality {
+            end += 1;
+        }
+        if end - i >= 2 {
+            blocks.push(Block::new(i, end - i));
+            i = end;
+        } else {
+            i = end.max(i + 1);
+        }
+    }
+    jr.blocks = block_start..blocks.len();
+    masses(&jr, rows, blocks, bodies);
     Some(jr)
 }
 
-/// Rebuilds the rows of `jr` from the bodies' *current* poses (the soft step moves them every
-/// substep), keeping each slot's accumulated impulse. Box2D v3 rotates the anchors by each
-/// body's delta rotation in every solve (`b2SolveRevoluteJoint`); a row built once per step
-/// keeps the lever arms and axes of the step start, a linearisation that lets the joint
-/// drift and pump energy. `C` is shifted by `-J·(dp, dq)` so that the delta tracking of
-/// [`Row::solve`] starts from the current error.
-pub(crate) fn refresh_rows(
-    jr: &mut JointRows,
+/// Updates the rows of `jr` from the bodies' *current* poses (the soft step moves them every
+/// substep), keeping kinds, bounds and accumulated impulses. Box2D v3 rotates the anchors by
+/// each body's delta rotation in every solve (`b2SolveRevoluteJoint`); a row built once per
+/// step keeps the lever arms and axes of the step start, a linearisation that lets the
+/// joint drift and pump energy.
+pub(crate) fn refresh_joint(
+    jr: &JointRows,
     joint: &Joint,
     set: &BodySet,
     bodies: &[SolverBody],
-    h: Real,
+    rows: &mut [Row],
+    blocks: &mut [Block],
 ) {
-    let mut impulses = [0.0; ROW_SLOTS];
-    for (slot, row) in &jr.rows {
-        impulses[*slot] = row.impulse;
-    }
-    fill_rows(joint, set, bodies, h, jr);
+    let f = jr.frames(set);
+    let own = &mut rows[jr.rows.clone()];
+    let mut sink = Sink::Overwrite(own, 0);
+    // `h` only sizes motor bounds and spring softness, which an overwrite keeps.
+    generate(&joint.desc.kind, &f, 0.0, &mut sink);
+    debug_assert!(matches!(sink, Sink::Overwrite(r, n) if n == r.len()));
+    masses(jr, rows, blocks, bodies);
+}
+
+/// Effective masses: each block's `K⁻¹`, the scalar mass of every other row.
+fn masses(jr: &JointRows, rows: &mut [Row], blocks: &mut [Block], bodies: &[SolverBody]) {
     let (sa, sb) = (&bodies[jr.a], &bodies[jr.b]);
-    for (slot, row) in jr.rows.iter_mut() {
-        row.impulse = impulses[*slot].clamp(row.lo, row.hi);
-        row.c -= row.delta(sa, sb);
-    }
-}
-
-/// Fills `jr.rows` and `jr.blocks` (cleared first, capacity kept) from the current poses.
-fn fill_rows(joint: &Joint, set: &BodySet, bodies: &[SolverBody], h: Real, jr: &mut JointRows) {
-    let desc = &joint.desc;
-    let (a, b) = (jr.a, jr.b);
-    let fa = set.pose_of(a).mul(&desc.frame_a);
-    let fb = set.pose_of(b).mul(&desc.frame_b);
-    let d = fb.translation - fa.translation;
-    let q_rel = (fa.rotation.inverse() * fb.rotation).normalize();
-    let f = Frames {
-        ra: fb.translation - set.position[a],
-        rb: fb.translation - set.position[b],
-        d,
-        rot_a: fa.rotation,
-        rot_b: fb.rotation,
-        q_rel,
-    };
-    let rows = &mut jr.rows;
-    rows.clear();
-    let lock = Axis::default();
-    match desc.kind {
-        JointKind::Ball => linear_axes(&f, &[lock; 3], h, rows),
-        JointKind::Fixed => {
-            linear_axes(&f, &[lock; 3], h, rows);
-            angular_axes(&f, &[lock; 3], h, rows);
-        }
-        JointKind::Slider { limits, motor } => {
-            let x = Axis {
-                mode: limits.map_or(AxisMode::Free, |(low, high)| AxisMode::Limited {
-                    low,
-                    high,
-                }),
-                motor,
-                spring: None,
-            };
-            linear_axes(&f, &[x, lock, lock], h, rows);
-            angular_axes(&f, &[lock; 3], h, rows);
-        }
-        JointKind::Generic6Dof { linear, angular } => {
-            linear_axes(&f, &linear, h, rows);
-            angular_axes(&f, &angular, h, rows);
-        }
-        JointKind::Hinge { limits, motor } => {
-            linear_axes(&f, &[lock; 3], h, rows);
-            hinge(&f, limits, motor, h, rows);
-        }
-        JointKind::ConeTwist {
-            swing1,
-            swing2,
-            twist,
-        } => {
-            linear_axes(&f, &[lock; 3], h, rows);
-            cone_twist(&f, swing1, swing2, twist, rows);
-        }
-    }
-    let (sa, sb) = (&bodies[a], &bodies[b]);
-    // Runs of up to three consecutive equality rows become blocks; the other rows (and the
-    // rows of a block too ill-conditioned to invert) get their scalar effective mass.
-    jr.blocks.clear();
+    let own = &mut rows[jr.rows.clone()];
     let mut i = 0;
-    while i < rows.len() {
-        let mut end = i;
-        while end < rows.len() && end - i < 3 && rows[end].1.kind == RowKind::Equality {
-            end += 1;
+    for block in &mut blocks[jr.blocks.clone()] {
+        for row in &mut own[i..block.start] {
+            row.finish(sa, sb);
         }
-        let block = if end - i >= 2 {
-            Block::new(i, &rows[i..end], sa, sb)
-        } else {
-            None
-        };
-        match block {
-            Some(block) => {
-                jr.blocks.push(block);
-                i = end;
-            }
-            None => {
-                let end = end.max(i + 1);
-                for (_, row) in &mut rows[i..end] {
-                    *row = row.finish(sa, sb);
-                }
-                i = end;
-            }
-        }
+        let end = block.start + block.len;
+        block.update(&mut own[block.start..end], sa, sb);
+        i = end;
     }
-}
-
-/// Rows for one coordinate `value` along a generic axis: limits or lock, motor, spring.
-fn axis_rows(
-    base: usize,
-    ax: &Axis,
-    value: Real,
-    h: Real,
-    make: &dyn Fn(Real, Real, RowKind, Real) -> Row,
-    rows: &mut Vec<(usize, Row)>,
-) {
-    match ax.mode {
-        AxisMode::Locked => rows.push((base, make(1.0, value, RowKind::Equality, 0.0))),
-        AxisMode::Free => {}
-        AxisMode::Limited { low, high } if low == high => {
-            rows.push((base, make(1.0, value - low, RowKind::Equality, 0.0)))
-        }
-        AxisMode::Limited { low, high } => {
-            rows.push((base, make(1.0, value - low, RowKind::Inequality, 0.0)));
-            rows.push((base + 1, make(-1.0, high - value, RowKind::Inequality, 0.0)));
-        }
-    }
-    if ax.mode == AxisMode::Locked {
-        return;
-    }
-    if let Some(m) = ax.motor {
-        let kind = RowKind::Motor { speed: m.speed };
-        rows.push((base + 2, make(1.0, 0.0, kind, m.max_force * h)));
-    } else if let Some(s) = ax.spring {
-        let softness = Softness::new(s.hertz, s.damping_ratio, h);
-        rows.push((
-            base + 2,
-            make(1.0, value - s.rest, RowKind::Spring { softness }, 0.0),
-        ));
-    }
-}
-
-fn linear_axes(f: &Frames, axes: &[Axis; 3], h: Real, rows: &mut Vec<(usize, Row)>) {
-    for (i, ax) in axes.iter().enumerate() {
-        let axis = f.axis_a(i);
-        let value = f.d.dot(axis);
-        let make = |sign: Real, c: Real, kind: RowKind, max: Real| {
-            Row::linear(axis * sign, f.ra, f.rb, c, kind, max)
-        };
-        axis_rows(3 * i, ax, value, h, &make, rows);
-    }
-}
-
-fn angular_axes(f: &Frames, axes: &[Axis; 3], h: Real, rows: &mut Vec<(usize, Row)>) {
-    let e = rotation_vector(f.q_rel);
-    for (i, ax) in axes.iter().enumerate() {
-        let axis = f.axis_a(i);
-        let make =
-            |sign: Real, c: Real, kind: RowKind, max: Real| Row::angular(axis * sign, c, kind, max);
-        axis_rows(9 + 3 * i, ax, e[i], h, &make, rows);
-    }
-}
-
-/// Hinge about frame Z: two rows keep the Z axes aligned (`c = pᵢ·(z_a × z_b)` is B's
-/// rotation about `pᵢ`), then limits and motor on the angle of B's X axis in A's XY plane.
-fn hinge(
-    f: &Frames,
-    limits: Option<(Real, Real)>,
-    motor: Option<super::Motor>,
-    h: Real,
-    rows: &mut Vec<(usize, Row)>,
-) {
-    let za = f.axis_a(2);
-    let zb = f.rot_b * Vec3::Z;
-    let err = za.cross(zb);
-    for i in 0..2 {
-        let p = f.axis_a(i);
-        rows.push((
-            9 + 3 * i,
-            Row::angular(p, p.dot(err), RowKind::Equality, 0.0),
-        ));
-    }
-    let q = f.q_rel;
-    let angle = 2.0 * q.z.atan2(q.w);
-    let angle = wrap_angle(angle);
-    let ax = Axis {
-        mode: limits.map_or(AxisMode::Free, |(low, high)| AxisMode::Limited {
-            low,
-            high,
-        }),
-        motor,
-        spring: None,
-    };
-    let make =
-        |sign: Real, c: Real, kind: RowKind, max: Real| Row::angular(za * sign, c, kind, max);
-    axis_rows(15, &ax, angle, h, &make, rows);
-}
-
-fn wrap_angle(a: Real) -> Real {
-    use carom_collision::math::consts::PI;
-    if a > PI {
-        a - 2.0 * PI
-    } else if a < -PI {
-        a + 2.0 * PI
-    } else {
-        a
-    }
-}
-
-/// Cone-twist: `q_rel = q_swing · q_twist` with the twist about X. The swing angle `φ` along
-/// the swing direction `u = (0, u_y, u_z)` is limited by the ellipse
-/// `1/φ_max² = (u_y/swing2)² + (u_z/swing1)²`; the twist angle by `±twist`. Limit rows are
-/// always present and act speculatively while inside the limits.
-fn cone_twist(f: &Frames, swing1: Real, swing2: Real, twist: Real, rows: &mut Vec<(usize, Row)>) {
-    let q = if f.q_rel.w < 0.0 { -f.q_rel } else { f.q_rel };
-    let tw_len = (q.x * q.x + q.w * q.w).sqrt();
-    let q_twist = if tw_len > 1e-9 {
-        Quat::from_xyzw(q.x / tw_len, 0.0, 0.0, q.w / tw_len)
-    } else {
-        Quat::IDENTITY
-    };
-    let twist_angle = wrap_angle(2.0 * q_twist.x.atan2(q_twist.w));
-    let swing = rotation_vector((q * q_twist.inverse()).normalize());
-    let phi = swing.length();
-    if phi > 1e-6 {
-        let u = swing / phi;
-        let (s1, s2) = (swing1.max(1e-3), swing2.max(1e-3));
-        let inv_sq = (u.y / s2).powi(2) + (u.z / s1).powi(2);
-        let phi_max = if inv_sq > 0.0 {
-            1.0 / inv_sq.sqrt()
-        } else {
-            s1.max(s2)
-        };
-        let axis = f.rot_a * u;
-        rows.push((
-            9,
-            Row::angular(-axis, phi_max - phi, RowKind::Inequality, 0.0),
-        ));
-    }
-    let tw = (f.axis_a(0) + f.rot_b * Vec3::X).normalize_or_zero();
-    if tw != Vec3::ZERO {
-        rows.push((
-            12,
-            Row::angular(tw, twist_angle + twist, RowKind::Inequality, 0.0),
-        ));
-        rows.push((
-            13,
-            Row::angular(-tw, twist - twist_angle, RowKind::Inequality, 0.0),
-        ));
+    for row in &mut own[i..] {
+        row.finish(sa, sb);
     }
 }
 
@@ -361,13 +203,5 @@ mod tests {
                 "{angle}"
             );
         }
-    }
-
-    #[test]
-    fn wrap_angle_stays_in_range() {
-        use carom_collision::math::consts::PI;
-        assert!((wrap_angle(1.5 * PI) + 0.5 * PI).abs() < 1e-5);
-        assert!((wrap_angle(-1.5 * PI) - 0.5 * PI).abs() < 1e-5);
-        assert_eq!(wrap_angle(0.25), 0.25);
     }
 }

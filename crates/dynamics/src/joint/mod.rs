@@ -1,16 +1,20 @@
 //! Joints: descriptions, a generational joint set, and conversion from scene descriptions.
 //!
 //! Every joint is a list of one-dimensional rows ([`crate::solver`]'s generic rows) built
-//! each step from the two joint frames, as Bullet's `btTypedConstraint::getInfo2` does:
+//! each step from the two joint frames (and refreshed in place after every substep of the
+//! soft step), as Bullet's `btTypedConstraint::getInfo2` does:
 //! point-to-point (`btPoint2PointConstraint`), hinge (`btHingeConstraint`, axis = frame Z),
 //! cone-twist (`btConeTwistConstraint`, twist axis = frame X, `setLimit(swing1, swing2,
 //! twist)`), slider (axis = frame X), fixed, and a generic 6-DOF joint
 //! (`btGeneric6DofSpring2Constraint`) with per-axis limits, springs and motors.
 
 mod build;
+mod generate;
 mod scene;
+#[cfg(test)]
+mod tests;
 
-pub(crate) use build::{build_rows, refresh_rows, JointRows, ROW_SLOTS};
+pub(crate) use build::{prepare_joint, refresh_joint, JointRows, ROW_SLOTS};
 
 use crate::body_set::BodyHandle;
 use carom_collision::math::{check_finite, check_isometry, check_non_negative, Isometry, Real};

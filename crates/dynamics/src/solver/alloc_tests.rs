@@ -8,7 +8,7 @@ use crate::body::BodyDesc;
 use crate::body_set::{BodyHandle, BodySet};
 use crate::contact::{ContactManifold, ContactPoint};
 use crate::integrate;
-use crate::joint::JointSet;
+use crate::joint::{Axis, AxisMode, JointDesc, JointKind, JointSet, Motor, Spring};
 use carom_collision::math::{Isometry, Quat, Real, Vec3};
 use carom_collision::shape::{Cuboid, Shape};
 use std::alloc::{GlobalAlloc, Layout, System};
@@ -91,12 +91,66 @@ fn resting_stack(n: usize) -> (BodySet, Vec<ContactManifold>) {
     (set, manifolds)
 }
 
-/// Allocations of the solver step in each of `steps` steps after a warm-up step.
-fn solver_allocations(kind: SolverKind, steps: usize) -> Vec<usize> {
-    let (mut set, mut manifolds) = resting_stack(8);
+/// One joint of each type between consecutive boxes of the stack (bodies `1..`), anchored
+/// at the face they share.
+fn stack_joints(set: &BodySet, n: usize) -> JointSet {
     let mut joints = JointSet::default();
+    let handles: Vec<BodyHandle> = set.handles().collect();
+    let spring = Axis {
+        mode: AxisMode::Free,
+        motor: None,
+        spring: Some(Spring {
+            hertz: 5.0,
+            damping_ratio: 0.5,
+            rest: 0.0,
+        }),
+    };
+    let motor = Some(Motor {
+        speed: 0.5,
+        max_force: 10.0,
+    });
+    let kinds = [
+        JointKind::Ball,
+        JointKind::Hinge {
+            limits: Some((-0.5, 0.5)),
+            motor,
+        },
+        JointKind::ConeTwist {
+            swing1: 0.4,
+            swing2: 0.3,
+            twist: 0.2,
+        },
+        JointKind::Slider {
+            limits: Some((-0.1, 0.1)),
+            motor,
+        },
+        JointKind::Fixed,
+        JointKind::Generic6Dof {
+            linear: [Axis::default(), spring, Axis::default()],
+            angular: [Axis::default(), spring, Axis::default()],
+        },
+    ];
+    for (i, pair) in handles[1..=n].windows(2).enumerate() {
+        let frame_a = Isometry::from_translation(Vec3::new(0.0, 0.5, 0.0));
+        let frame_b = Isometry::from_translation(Vec3::new(0.0, -0.5, 0.0));
+        let kind = kinds[i % kinds.len()];
+        joints.insert(JointDesc::new(pair[0], pair[1], frame_a, frame_b, kind));
+    }
+    joints
+}
+
+/// Allocations of the solver step in each of `steps` steps after a warm-up step, with a
+/// joint between every two boxes when `with_joints`.
+fn solver_allocations(kind: SolverKind, steps: usize, with_joints: bool) -> Vec<usize> {
+    let (mut set, mut manifolds) = resting_stack(8);
+    let mut joints = if with_joints {
+        stack_joints(&set, 8)
+    } else {
+        JointSet::default()
+    };
     let mut bodies: Vec<SolverBody> = Vec::new();
     let mut scratch = SolverScratch::default();
+    let mut joint_scratch = super::joints::JointScratch::default();
     let params = SolverParams {
         kind,
         ..Default::default()
@@ -117,6 +171,7 @@ fn solver_allocations(kind: SolverKind, steps: usize) -> Vec<usize> {
             parallel: false,
             timings: &mut timings,
             scratch: &mut scratch,
+            joint_scratch: &mut joint_scratch,
         };
         counts.push(count_allocations(|| match kind {
             SolverKind::SoftStep => soft_step::step(&mut ctx),
@@ -124,8 +179,10 @@ fn solver_allocations(kind: SolverKind, steps: usize) -> Vec<usize> {
         }));
         integrate::store(&mut set, &bodies);
     }
-    // The stack really was solved: every contact carries weight.
+    // The stack really was solved: every contact carries weight, every joint has rows.
     assert!(manifolds.iter().all(|m| m.total_normal_impulse() > 0.0));
+    assert_eq!(joint_scratch.joints.len(), joints.len());
+    assert!(joint_scratch.rows.len() >= 3 * joints.len());
     counts.remove(0);
     counts
 }
@@ -141,7 +198,7 @@ fn the_counter_sees_allocations() {
 
 #[test]
 fn soft_step_solver_allocates_nothing_after_warm_up() {
-    let counts = solver_allocations(SolverKind::SoftStep, 20);
+    let counts = solver_allocations(SolverKind::SoftStep, 20, false);
     assert!(
         counts.iter().all(|&c| c == 0),
         "allocations per step: {counts:?}"
@@ -150,9 +207,20 @@ fn soft_step_solver_allocates_nothing_after_warm_up() {
 
 #[test]
 fn sequential_impulse_solver_allocates_nothing_after_warm_up() {
-    let counts = solver_allocations(SolverKind::SequentialImpulse, 20);
+    let counts = solver_allocations(SolverKind::SequentialImpulse, 20, false);
     assert!(
         counts.iter().all(|&c| c == 0),
         "allocations per step: {counts:?}"
     );
+}
+
+#[test]
+fn joint_rows_allocate_nothing_after_warm_up() {
+    for kind in [SolverKind::SoftStep, SolverKind::SequentialImpulse] {
+        let counts = solver_allocations(kind, 20, true);
+        assert!(
+            counts.iter().all(|&c| c == 0),
+            "{kind:?}: allocations per step: {counts:?}"
+        );
+    }
 }

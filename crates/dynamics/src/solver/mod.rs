@@ -158,6 +158,8 @@ pub(crate) struct StepContext<'a> {
     pub timings: &'a mut StepTimings,
     /// Reused buffers: no allocation in the solver once they have grown to the scene.
     pub scratch: &'a mut SolverScratch,
+    /// The joint rows of the step, reused likewise.
+    pub joint_scratch: &'a mut joints::JointScratch,
 }
 
 /// Per-body state the solver works on (Box2D v3's `b2BodyState`), copied from the body set

@@ -1,12 +1,50 @@
 //! Generic one-dimensional constraint rows, the building blocks of every joint.
 //!
-//! A row is a Jacobian `J = (lin_a, ang_a, lin_b, ang_b)` with a position error `C`, solved
+//! A row is a Jacobian `J = (−lin, ang_a, lin, ang_b)` with a position error `C`, solved
 //! as in Catto's sequential impulses: `λ = -m_eff·(J v + bias)`, accumulated and clamped.
 //! Bullet's joints (`btTypedConstraint::getInfo2`) and Box2D v3's joints are written the same
-//! way; here every joint type only *builds* rows and one routine solves them all.
+//! way; here every joint type only *builds* rows and one routine solves them all. The linear
+//! parts of both bodies are equal and opposite (a linear row pushes the bodies apart along
+//! one direction, an angular row has none), so a row keeps one `lin`.
+//!
+//! A row keeps its angular Jacobians premultiplied by the bodies' inverse world inertias
+//! (`ia`, `ib`, computed with the effective mass): the inverse inertias are fixed for the
+//! step, so applying an impulse is four scaled adds, as in the contact rows.
 
 use super::{inv_or_zero, Softness, SolverBody};
 use carom_collision::math::{Mat3, Real, Vec3};
+
+/// The part of a body that solving a row reads and writes: its velocities and inverse
+/// mass (the inverse inertia is folded into each row's `ia`/`ib`). Small, so a joint's
+/// passes copy two of these rather than two whole [`SolverBody`]s.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Motion {
+    pub v: Vec3,
+    pub w: Vec3,
+    pub inv_m: Real,
+}
+
+impl Motion {
+    /// The velocities and inverse mass of `b`.
+    #[inline]
+    pub fn of(b: &SolverBody) -> Motion {
+        Motion {
+            v: b.v,
+            w: b.w,
+            inv_m: b.inv_m,
+        }
+    }
+
+    /// Writes the velocities back into `b` when it is dynamic (the only bodies the solver
+    /// changes).
+    #[inline]
+    pub fn store(&self, b: &mut SolverBody) {
+        if b.dynamic {
+            b.v = self.v;
+            b.w = self.w;
+        }
+    }
+}
 
 /// How a row constrains its velocity.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -24,110 +62,104 @@ pub(crate) enum RowKind {
 /// One prepared row.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Row {
-    pub lin_a: Vec3,
+    /// Linear Jacobian of B (A's is `-lin`).
+    pub lin: Vec3,
     pub ang_a: Vec3,
-    pub lin_b: Vec3,
     pub ang_b: Vec3,
+    /// `I_a⁻¹ ang_a` and `I_b⁻¹ ang_b` (set by [`Row::finish`] or [`Block::update`]).
+    pub ia: Vec3,
+    pub ib: Vec3,
     pub inv_k: Real,
     pub c: Real,
     pub kind: RowKind,
     pub lo: Real,
     pub hi: Real,
     pub impulse: Real,
+    /// The joint's warm-starting slot of this row (`< ROW_SLOTS`).
+    pub slot: u8,
 }
 
 impl Row {
-    /// A row with Jacobian `J` and error `c`; bounds come from `kind` (`max` for motors).
-    pub fn new(j: [Vec3; 4], c: Real, kind: RowKind, max: Real) -> Row {
+    /// A row for `slot` with Jacobian `j = [lin, ang_a, ang_b]` and error `c`; bounds come
+    /// from `kind` (`max` for motors). The effective mass is set later ([`Row::finish`] or a
+    /// [`Block`]).
+    pub fn new(slot: u8, j: [Vec3; 3], c: Real, kind: RowKind, max: Real) -> Row {
         let (lo, hi) = match kind {
             RowKind::Equality | RowKind::Spring { .. } => (Real::NEG_INFINITY, Real::INFINITY),
             RowKind::Inequality => (0.0, Real::INFINITY),
             RowKind::Motor { .. } => (-max, max),
         };
         Row {
-            lin_a: j[0],
+            lin: j[0],
             ang_a: j[1],
-            lin_b: j[2],
-            ang_b: j[3],
+            ang_b: j[2],
+            ia: Vec3::ZERO,
+            ib: Vec3::ZERO,
             inv_k: 0.0,
             c,
             kind,
             lo,
             hi,
             impulse: 0.0,
+            slot,
         }
     }
 
-    /// A linear row along `axis` between anchors at lever arms `ra` (from A's centre of mass
-    /// to B's anchor) and `rb`.
-    pub fn linear(axis: Vec3, ra: Vec3, rb: Vec3, c: Real, kind: RowKind, max: Real) -> Row {
-        Row::new([-axis, -ra.cross(axis), axis, rb.cross(axis)], c, kind, max)
+    /// Replaces the Jacobian and the error (a refresh from new poses), keeping the kind,
+    /// bounds and accumulated impulse.
+    #[inline]
+    pub fn set(&mut self, j: [Vec3; 3], c: Real) {
+        self.lin = j[0];
+        self.ang_a = j[1];
+        self.ang_b = j[2];
+        self.c = c;
     }
 
-    /// An angular row about `axis` (`J v = axis · (ω_b − ω_a)`).
-    pub fn angular(axis: Vec3, c: Real, kind: RowKind, max: Real) -> Row {
-        Row::new([Vec3::ZERO, -axis, Vec3::ZERO, axis], c, kind, max)
-    }
-
-    /// Computes the effective mass from the two bodies.
-    pub fn finish(mut self, a: &SolverBody, b: &SolverBody) -> Row {
-        let k = a.inv_m * self.lin_a.length_squared()
-            + b.inv_m * self.lin_b.length_squared()
-            + self.ang_a.dot(a.inv_i * self.ang_a)
-            + self.ang_b.dot(b.inv_i * self.ang_b);
+    /// Computes the inertia-weighted angular Jacobians and the effective mass.
+    #[inline]
+    pub fn finish(&mut self, a: &SolverBody, b: &SolverBody) {
+        self.ia = a.inv_i * self.ang_a;
+        self.ib = b.inv_i * self.ang_b;
+        let k = (a.inv_m + b.inv_m) * self.lin.length_squared()
+            + self.ang_a.dot(self.ia)
+            + self.ang_b.dot(self.ib);
         self.inv_k = inv_or_zero(k);
-        self
     }
 
     #[inline]
-    pub(crate) fn velocity(&self, a: &SolverBody, b: &SolverBody) -> Real {
-        self.lin_a.dot(a.v) + self.ang_a.dot(a.w) + self.lin_b.dot(b.v) + self.ang_b.dot(b.w)
+    pub(crate) fn velocity(&self, a: &Motion, b: &Motion) -> Real {
+        self.lin.dot(b.v - a.v) + self.ang_a.dot(a.w) + self.ang_b.dot(b.w)
     }
 
     #[inline]
-    pub(crate) fn apply(&self, a: &mut SolverBody, b: &mut SolverBody, lambda: Real) {
-        a.v += self.lin_a * (a.inv_m * lambda);
-        a.w += a.inv_i * self.ang_a * lambda;
-        b.v += self.lin_b * (b.inv_m * lambda);
-        b.w += b.inv_i * self.ang_b * lambda;
+    pub(crate) fn apply(&self, a: &mut Motion, b: &mut Motion, lambda: Real) {
+        a.v -= self.lin * (a.inv_m * lambda);
+        a.w += self.ia * lambda;
+        b.v += self.lin * (b.inv_m * lambda);
+        b.w += self.ib * lambda;
     }
 
-    /// Applies the accumulated impulse.
-    pub fn warm_start(&self, a: &mut SolverBody, b: &mut SolverBody) {
-        self.apply(a, b, self.impulse);
-    }
-
-    /// `J · (dp, dq)`: how far the position deltas since the step start moved the row.
-    #[inline]
-    pub(crate) fn delta(&self, a: &SolverBody, b: &SolverBody) -> Real {
-        self.lin_a.dot(a.dp) + self.ang_a.dot(a.dq) + self.lin_b.dot(b.dp) + self.ang_b.dot(b.dq)
-    }
-
-    /// The position error: `C` of the preparation plus, when `track_deltas`, the change
-    /// linearised from the position deltas (exact right after a refresh, which folds the
-    /// deltas so far into `c`).
-    #[inline]
-    fn error(&self, a: &SolverBody, b: &SolverBody, track_deltas: bool) -> Real {
-        if track_deltas {
-            self.c + self.delta(a, b)
-        } else {
-            self.c
+    /// Applies the accumulated impulse (nothing for a row without one, such as a limit
+    /// that was not reached).
+    pub fn warm_start(&self, a: &mut Motion, b: &mut Motion) {
+        if self.impulse != 0.0 {
+            self.apply(a, b, self.impulse);
         }
     }
 
     /// One sequential-impulse update. `soft` is the position feedback of equality and
-    /// violated inequality rows when `use_bias`; `track_deltas` updates `C` from the position
-    /// deltas of the substeps (soft step) instead of keeping the value of the preparation.
+    /// violated inequality rows when `use_bias`. `C` is the value of the last build or
+    /// refresh: the soft step refreshes the rows whenever the poses have moved, so it is
+    /// the current error.
     pub fn solve(
         &mut self,
-        a: &mut SolverBody,
-        b: &mut SolverBody,
+        a: &mut Motion,
+        b: &mut Motion,
         soft: Softness,
         inv_h: Real,
         use_bias: bool,
-        track_deltas: bool,
     ) {
-        let c = self.error(a, b, track_deltas);
+        let c = self.c;
         let (bias, mass_scale, impulse_scale) = match self.kind {
             RowKind::Equality if use_bias => {
                 (soft.bias_rate * c, soft.mass_scale, soft.impulse_scale)
@@ -149,7 +181,10 @@ impl Row {
         let new = (self.impulse + lambda).clamp(self.lo, self.hi);
         let lambda = new - self.impulse;
         self.impulse = new;
-        self.apply(a, b, lambda);
+        // A clamped row (typically a limit far from being reached) changes nothing.
+        if lambda != 0.0 {
+            self.apply(a, b, lambda);
+        }
     }
 }
 
@@ -159,75 +194,94 @@ impl Row {
 /// the rows one after another instead is one Gauss–Seidel sweep on a `K` whose rows are
 /// strongly coupled when a lever arm is long against the body's radius of gyration; with
 /// the soft step's single iteration per substep that sweep leaves most of the error.
+///
+/// Which rows form a block is fixed when the joint's rows are built for the step; `K` is
+/// recomputed at every refresh ([`Block::update`]), and a refresh that finds it nearly
+/// singular marks the block invalid, so its rows are solved one by one until the next.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Block {
     /// First row index in the joint's row list.
     pub start: usize,
     /// Number of rows (1..=3).
     pub len: usize,
-    /// Inverse of `K`, padded with the identity past `len`.
+    /// Inverse of `K`, padded with the identity past `len` (meaningful when `valid`).
     pub inv_k: Mat3,
+    /// False when the last update found `K` nearly singular.
+    pub valid: bool,
 }
 
 impl Block {
-    /// The block over `rows` (all equality rows, with their slots), or `None` when its `K`
-    /// is nearly singular (then the rows are solved one by one).
-    pub fn new(
-        start: usize,
-        rows: &[(usize, Row)],
-        a: &SolverBody,
-        b: &SolverBody,
-    ) -> Option<Block> {
-        let len = rows.len();
+    /// A block over `len` rows from `start`, to be [updated](Block::update) before use.
+    pub fn new(start: usize, len: usize) -> Block {
         debug_assert!((1..=3).contains(&len));
-        // K_ij = J_i M⁻¹ J_jᵀ: one inverse-inertia product per row, then dot products.
-        let mut k = Mat3::IDENTITY;
-        let ang: [(Vec3, Vec3); 3] = std::array::from_fn(|j| {
-            let r = &rows[j.min(len - 1)].1;
-            (a.inv_i * r.ang_a, b.inv_i * r.ang_b)
-        });
-        for (j, (_, rj)) in rows.iter().enumerate() {
-            for (i, (_, ri)) in rows.iter().enumerate().take(j + 1) {
-                let kij = a.inv_m * ri.lin_a.dot(rj.lin_a)
-                    + b.inv_m * ri.lin_b.dot(rj.lin_b)
-                    + ri.ang_a.dot(ang[j].0)
-                    + ri.ang_b.dot(ang[j].1);
-                k.col_mut(j)[i] = kij;
-                k.col_mut(i)[j] = kij;
-            }
-        }
-        let diag: Real = (0..3).map(|i| k.col(i)[i]).product();
-        let det = k.determinant();
-        // Relative conditioning test: a nearly singular K is solved row by row instead.
-        if !(det.is_finite() && diag > 0.0 && det > 1e-4 * diag) {
-            return None;
-        }
-        Some(Block {
+        Block {
             start,
             len,
-            inv_k: k.inverse(),
-        })
+            inv_k: Mat3::IDENTITY,
+            valid: false,
+        }
+    }
+
+    /// Recomputes `K⁻¹` from `rows` (the block's rows, all equality rows) and their
+    /// inertia-weighted Jacobians. When `K` is nearly singular the block is marked invalid
+    /// and each row gets its scalar effective mass instead.
+    pub fn update(&mut self, rows: &mut [Row], a: &SolverBody, b: &SolverBody) {
+        debug_assert_eq!(rows.len(), self.len);
+        // K_ij = J_i M⁻¹ J_jᵀ: one inverse-inertia product per row, then dot products.
+        for r in rows.iter_mut() {
+            r.ia = a.inv_i * r.ang_a;
+            r.ib = b.inv_i * r.ang_b;
+        }
+        // The six entries of the symmetric K, padded with the identity past `len`.
+        let inv_m = a.inv_m + b.inv_m;
+        let e = |i: usize, j: usize| match (rows.get(i), rows.get(j)) {
+            (Some(ri), Some(rj)) => {
+                inv_m * ri.lin.dot(rj.lin) + ri.ang_a.dot(rj.ia) + ri.ang_b.dot(rj.ib)
+            }
+            _ if i == j => 1.0,
+            _ => 0.0,
+        };
+        let (k00, k01, k02) = (e(0, 0), e(0, 1), e(0, 2));
+        let (k11, k12, k22) = (e(1, 1), e(1, 2), e(2, 2));
+        // Cofactors: K⁻¹ = C / det for a symmetric K.
+        let c00 = k11 * k22 - k12 * k12;
+        let c01 = k02 * k12 - k01 * k22;
+        let c02 = k01 * k12 - k02 * k11;
+        let det = k00 * c00 + k01 * c01 + k02 * c02;
+        let diag = k00 * k11 * k22;
+        // Relative conditioning test: a nearly singular K is solved row by row instead.
+        self.valid = det.is_finite() && diag > 0.0 && det > 1e-4 * diag;
+        if self.valid {
+            let c11 = k00 * k22 - k02 * k02;
+            let c12 = k01 * k02 - k00 * k12;
+            let c22 = k00 * k11 - k01 * k01;
+            let inv_det = 1.0 / det;
+            self.inv_k = Mat3::from_cols(
+                Vec3::new(c00, c01, c02) * inv_det,
+                Vec3::new(c01, c11, c12) * inv_det,
+                Vec3::new(c02, c12, c22) * inv_det,
+            );
+        } else {
+            for r in rows.iter_mut() {
+                r.finish(a, b);
+            }
+        }
     }
 
     /// One block update of `rows` (the block's rows), with the same soft feedback as
     /// [`Row::solve`] gives an equality row.
     pub fn solve(
         &self,
-        rows: &mut [(usize, Row)],
-        a: &mut SolverBody,
-        b: &mut SolverBody,
+        rows: &mut [Row],
+        a: &mut Motion,
+        b: &mut Motion,
         soft: Softness,
         use_bias: bool,
-        track_deltas: bool,
     ) {
         let mut rhs = Vec3::ZERO;
         let mut acc = Vec3::ZERO;
-        for (i, (_, r)) in rows.iter().enumerate() {
-            let bias = if use_bias {
-                soft.bias_rate * r.error(a, b, track_deltas)
-            } else {
-                0.0
-            };
+        for (i, r) in rows.iter().enumerate() {
+            let bias = if use_bias { soft.bias_rate * r.c } else { 0.0 };
             rhs[i] = r.velocity(a, b) + bias;
             acc[i] = r.impulse;
         }
@@ -237,7 +291,7 @@ impl Block {
             (1.0, 0.0)
         };
         let lambda = -(self.inv_k * rhs) * mass_scale - acc * impulse_scale;
-        for (i, (_, r)) in rows.iter_mut().enumerate() {
+        for (i, r) in rows.iter_mut().enumerate() {
             r.impulse += lambda[i];
             r.apply(a, b, lambda[i]);
         }

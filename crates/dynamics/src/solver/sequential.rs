@@ -33,13 +33,14 @@ pub(crate) fn step(ctx: &mut StepContext) {
         scratch,
     );
     let (cons, ranges) = (&mut scratch.cons, &scratch.colouring.ranges[..]);
-    let mut rows = joints::build_all(ctx.joints, ctx.set, ctx.bodies, dt, warm);
+    let rows = &mut *ctx.joint_scratch;
+    joints::prepare(rows, ctx.joints, ctx.set, ctx.bodies, dt, warm);
     lap(&mut t, &mut ctx.timings.prepare);
 
     let bodies = &mut ctx.bodies[..];
     let (par, min) = (ctx.parallel, p.parallel_min_batch);
     if p.warm_starting {
-        joints::warm_start(&mut rows, bodies);
+        joints::warm_start(rows, bodies);
         solve_coloured(cons, ranges, bodies, par, min, contact::warm_start);
     }
     lap(&mut t, &mut ctx.timings.warm_start);
@@ -47,7 +48,7 @@ pub(crate) fn step(ctx: &mut StepContext) {
     let joint_soft = Softness::baumgarte(p.joint_erp, dt);
     let threshold = p.restitution_threshold;
     for _ in 0..p.velocity_iterations {
-        joints::solve(&mut rows, bodies, joint_soft, 1.0 / dt, true, false);
+        joints::solve(rows, bodies, joint_soft, 1.0 / dt, true);
         solve_coloured(cons, ranges, bodies, par, min, |c, a, b| {
             contact::solve_velocity_si(c, a, b, dt, threshold)
         });
@@ -71,6 +72,6 @@ pub(crate) fn step(ctx: &mut StepContext) {
     lap(&mut t, &mut ctx.timings.integrate);
 
     contact::store(cons, ctx.manifolds, 1.0);
-    joints::store(&rows, ctx.joints, 1.0);
+    joints::store(rows, ctx.joints, 1.0);
     lap(&mut t, &mut ctx.timings.store);
 }

@@ -61,22 +61,19 @@ pub(crate) fn step(ctx: &mut StepContext) {
         &scratch.colouring.ranges[..],
         &mut scratch.wide,
     );
-    let mut rows = joints::build_all(ctx.joints, ctx.set, ctx.bodies, h, warm);
+    let rows = &mut *ctx.joint_scratch;
+    joints::prepare(rows, ctx.joints, ctx.set, ctx.bodies, h, warm);
     let joint_soft = Softness::new(p.joint_hertz, p.joint_damping_ratio, h);
     let (par, min) = (ctx.parallel, p.parallel_min_batch);
     let max_push = p.max_push_velocity;
     lap(&mut t, &mut ctx.timings.prepare);
 
-    for substep in 0..n {
+    for _ in 0..n {
         integrate::integrate_velocities(ctx.set, ctx.bodies, ctx.gravity, h, ctx.gyroscopic);
         lap(&mut t, &mut ctx.timings.forces);
 
-        if substep > 0 {
-            // Joint rows follow the poses of the previous substep (built fresh for the first).
-            joints::refresh(&mut rows, ctx.joints, ctx.set, ctx.bodies, h);
-        }
         if p.warm_starting {
-            joints::warm_start(&mut rows, ctx.bodies);
+            joints::warm_start(rows, ctx.bodies);
             if simd {
                 let b = &mut *ctx.bodies;
                 let (w, s) = (contact_simd::warm_start, contact::warm_start);
@@ -87,7 +84,7 @@ pub(crate) fn step(ctx: &mut StepContext) {
         }
         lap(&mut t, &mut ctx.timings.warm_start);
 
-        joints::solve(&mut rows, ctx.bodies, joint_soft, inv_h, true, true);
+        joints::solve(rows, ctx.bodies, joint_soft, inv_h, true);
         let solve = (inv_h, max_push, true);
         solve_contacts(simd, wide, cons, ranges, ctx.bodies, (par, min), solve);
         integrate::clamp_speeds(ctx.set, ctx.bodies);
@@ -96,8 +93,9 @@ pub(crate) fn step(ctx: &mut StepContext) {
         integrate::integrate_positions(ctx.set, ctx.bodies, h, false);
         lap(&mut t, &mut ctx.timings.integrate);
 
-        joints::refresh(&mut rows, ctx.joints, ctx.set, ctx.bodies, h);
-        joints::solve(&mut rows, ctx.bodies, joint_soft, inv_h, false, true);
+        // Joint rows follow the new poses (they stay valid until the next position update).
+        joints::refresh(rows, ctx.joints, ctx.set, ctx.bodies);
+        joints::solve(rows, ctx.bodies, joint_soft, inv_h, false);
         let relax = (inv_h, max_push, false);
         solve_contacts(simd, wide, cons, ranges, ctx.bodies, (par, min), relax);
         lap(&mut t, &mut ctx.timings.relax);
@@ -123,7 +121,7 @@ pub(crate) fn step(ctx: &mut StepContext) {
     lap(&mut t, &mut ctx.timings.restitution);
 
     contact::store(cons, ctx.manifolds, n as Real);
-    joints::store(&rows, ctx.joints, n as Real);
+    joints::store(rows, ctx.joints, n as Real);
     lap(&mut t, &mut ctx.timings.store);
 }
 

@@ -1,0 +1,306 @@
+//! The per-substep refresh against its oracle, a fresh preparation at the same poses: for
+//! every joint type, with off-centre masses and far from the origin, the refreshed rows
+//! (Jacobians, errors, effective masses, blocks) equal the rows built from scratch, and
+//! the accumulated impulses are kept. Also the rows that are undefined at some poses (the
+//! cone's swing and twist axes).
+
+use super::build::{prepare_joint, refresh_joint, JointRows};
+use super::{Axis, AxisMode, JointDesc, JointKind, JointSet, Motor, Spring};
+use crate::body::BodyDesc;
+use crate::body_set::{BodyHandle, BodySet};
+use crate::integrate;
+use crate::solver::rows::{Block, Row};
+use crate::solver::SolverBody;
+use carom_collision::math::{Isometry, Quat, Real, Vec3};
+use carom_collision::shape::{ConvexHull, Shape};
+use std::sync::Arc;
+
+/// A box-shaped hull whose centre of mass is off the body origin.
+fn off_centre_hull(offset: Vec3) -> Arc<Shape> {
+    let mut points = Vec::new();
+    for i in 0..8 {
+        let s = |bit: usize| if i & bit != 0 { 1.0 } else { -1.0 };
+        points.push(offset + Vec3::new(0.4 * s(1), 0.2 * s(2), 0.3 * s(4)));
+    }
+    Arc::new(ConvexHull::new(&points).unwrap().into())
+}
+
+fn kinds() -> Vec<JointKind> {
+    let spring = Axis {
+        mode: AxisMode::Limited {
+            low: -0.2,
+            high: 0.3,
+        },
+        motor: None,
+        spring: Some(Spring {
+            hertz: 4.0,
+            damping_ratio: 0.7,
+            rest: 0.1,
+        }),
+    };
+    let motor = Some(Motor {
+        speed: 1.0,
+        max_force: 5.0,
+    });
+    let free = Axis {
+        mode: AxisMode::Free,
+        motor,
+        spring: None,
+    };
+    vec![
+        JointKind::Ball,
+        JointKind::Fixed,
+        JointKind::Hinge {
+            limits: None,
+            motor: None,
+        },
+        JointKind::Hinge {
+            limits: Some((-0.4, 0.9)),
+            motor,
+        },
+        JointKind::ConeTwist {
+            swing1: 0.5,
+            swing2: 0.3,
+            twist: 0.2,
+        },
+        JointKind::Slider {
+            limits: Some((-0.5, 0.5)),
+            motor,
+        },
+        JointKind::Generic6Dof {
+            linear: [spring, Axis::default(), free],
+            angular: [free, spring, Axis::default()],
+        },
+    ]
+}
+
+struct Rig {
+    set: BodySet,
+    joints: JointSet,
+    a: BodyHandle,
+    b: BodyHandle,
+}
+
+fn rig(kind: JointKind, origin: Vec3) -> Rig {
+    let mut set = BodySet::new();
+    let pose_a = Isometry::new(origin, Quat::from_rotation_y(0.3));
+    let pose_b = Isometry::new(
+        origin + Vec3::new(0.9, 0.1, -0.2),
+        Quat::from_rotation_x(-0.2),
+    );
+    let a = set
+        .insert(&BodyDesc::dynamic(
+            off_centre_hull(Vec3::new(0.2, -0.1, 0.05)),
+            pose_a,
+            1000.0,
+        ))
+        .unwrap();
+    let b = set
+        .insert(&BodyDesc::dynamic(
+            off_centre_hull(Vec3::new(-0.1, 0.15, 0.2)),
+            pose_b,
+            700.0,
+        ))
+        .unwrap();
+    let frame_a = Isometry::new(Vec3::new(0.5, 0.05, 0.0), Quat::from_rotation_z(0.4));
+    // Frame B at the same world pose as frame A: the joint starts satisfied.
+    let frame_b = pose_b.inv_mul(&pose_a.mul(&frame_a));
+    let mut joints = JointSet::default();
+    joints.insert(JointDesc::new(a, b, frame_a, frame_b, kind));
+    Rig { set, joints, a, b }
+}
+
+fn prepare(r: &Rig, bodies: &[SolverBody]) -> (JointRows, Vec<Row>, Vec<Block>) {
+    let (mut rows, mut blocks) = (Vec::new(), Vec::new());
+    let (_, j) = r.joints.iter().next().unwrap();
+    let jr = prepare_joint(
+        0,
+        j,
+        &r.set,
+        bodies,
+        1.0 / 240.0,
+        0.25,
+        &mut rows,
+        &mut blocks,
+    );
+    (jr.unwrap(), rows, blocks)
+}
+
+fn moved(r: &mut Rig, turn_b: Quat) {
+    let (ia, ib) = (r.a.index as usize, r.b.index as usize);
+    r.set.position[ia] += Vec3::new(0.02, -0.03, 0.01);
+    r.set.rotation[ia] = (Quat::from_rotation_x(0.15) * r.set.rotation[ia]).normalize();
+    r.set.position[ib] += Vec3::new(-0.01, 0.04, 0.03);
+    r.set.rotation[ib] = (turn_b * r.set.rotation[ib]).normalize();
+}
+
+fn assert_same_rows(fresh: &[Row], refreshed: &[Row], what: &str) {
+    assert_eq!(fresh.len(), refreshed.len(), "{what}");
+    for (x, y) in fresh.iter().zip(refreshed) {
+        assert_eq!(x.slot, y.slot, "{what}");
+        assert_eq!(x.kind, y.kind, "{what}");
+        assert_eq!((x.lo, x.hi), (y.lo, y.hi), "{what}");
+        let jx = [x.lin, x.ang_a, x.ang_b, x.ia, x.ib];
+        let jy = [y.lin, y.ang_a, y.ang_b, y.ia, y.ib];
+        assert_eq!(jx, jy, "{what}: slot {}", x.slot);
+        assert_eq!(x.c, y.c, "{what}: slot {}", x.slot);
+        assert_eq!(x.inv_k, y.inv_k, "{what}: slot {}", x.slot);
+    }
+}
+
+#[test]
+fn refresh_equals_a_fresh_preparation_for_every_joint_type() {
+    for origin in [Vec3::ZERO, Vec3::new(1e3, -2e3, 5e2)] {
+        for kind in kinds() {
+            let what = format!("{kind:?} at {origin}");
+            let mut r = rig(kind, origin);
+            {
+                let (_, j) = r.joints.iter_mut().next().unwrap();
+                for (s, x) in j.impulses.iter_mut().enumerate() {
+                    *x = 0.01 * (s as Real + 1.0);
+                }
+            }
+            let mut bodies = Vec::new();
+            integrate::load(&r.set, &mut bodies);
+            let (jr, mut rows, mut blocks) = prepare(&r, &bodies);
+            for row in rows.iter_mut() {
+                row.impulse = (row.impulse + 0.5).clamp(row.lo, row.hi);
+            }
+            let kept: Vec<Real> = rows.iter().map(|row| row.impulse).collect();
+
+            moved(
+                &mut r,
+                Quat::from_axis_angle(Vec3::new(1.0, 2.0, -0.5).normalize(), 0.25),
+            );
+            let (_, j) = r.joints.iter().next().unwrap();
+            refresh_joint(&jr, j, &r.set, &bodies, &mut rows, &mut blocks);
+            let (_, fresh, fresh_blocks) = prepare(&r, &bodies);
+
+            assert_same_rows(&fresh, &rows, &what);
+            let kept_now: Vec<Real> = rows.iter().map(|row| row.impulse).collect();
+            assert_eq!(kept, kept_now, "{what}: impulses are kept");
+            assert_eq!(fresh_blocks.len(), blocks.len(), "{what}");
+            for (x, y) in fresh_blocks.iter().zip(&blocks) {
+                assert_eq!(
+                    (x.start, x.len, x.valid),
+                    (y.start, y.len, y.valid),
+                    "{what}"
+                );
+                assert_eq!(x.inv_k, y.inv_k, "{what}");
+            }
+            assert!(rows
+                .iter()
+                .all(|row| row.c.is_finite() && row.inv_k.is_finite()));
+        }
+    }
+}
+
+#[test]
+fn row_counts_follow_the_joint_description() {
+    let counts = [3, 6, 5, 8, 6, 8, 10];
+    for (kind, n) in kinds().into_iter().zip(counts) {
+        let r = rig(kind, Vec3::ZERO);
+        let mut bodies = Vec::new();
+        integrate::load(&r.set, &mut bodies);
+        let (jr, rows, blocks) = prepare(&r, &bodies);
+        assert_eq!(rows.len(), n, "{kind:?}");
+        assert_eq!(jr.rows, 0..n, "{kind:?}");
+        // Satisfied at the start: every equality row has zero error, every block is valid.
+        assert!(blocks.iter().all(|b| b.valid), "{kind:?}");
+        for row in &rows {
+            if row.kind == crate::solver::rows::RowKind::Equality {
+                assert!(
+                    row.c.abs() < 1e-4,
+                    "{kind:?}: slot {} c = {}",
+                    row.slot,
+                    row.c
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn cone_rows_are_inactive_where_their_axes_are_undefined() {
+    let kind = JointKind::ConeTwist {
+        swing1: 0.5,
+        swing2: 0.3,
+        twist: 0.2,
+    };
+    let mut r = rig(kind, Vec3::ZERO);
+    let mut bodies = Vec::new();
+    integrate::load(&r.set, &mut bodies);
+    // No swing at the start: the swing row (slot 9) has no axis.
+    let (jr, mut rows, mut blocks) = prepare(&r, &bodies);
+    let swing = rows.iter().position(|row| row.slot == 9).unwrap();
+    assert_eq!(rows[swing].ang_b, Vec3::ZERO);
+    assert_eq!((rows[swing].inv_k, rows[swing].impulse), (0.0, 0.0));
+    // A swing about frame A's Y axis (world: rotated by A's and the frame's rotation).
+    let fa = r
+        .set
+        .pose_of(r.a.index as usize)
+        .mul(&r.joints.iter().next().unwrap().1.desc.frame_a);
+    let y = fa.rotation * Vec3::Y;
+    moved(&mut r, Quat::from_axis_angle(y, 0.2));
+    let (_, j) = r.joints.iter().next().unwrap();
+    refresh_joint(&jr, j, &r.set, &bodies, &mut rows, &mut blocks);
+    assert!(rows[swing].ang_b.length() > 0.5 && rows[swing].inv_k > 0.0);
+    // Back to no swing (B's frame turned onto A's, plus a twist about their common X):
+    // the swing row is inactive again and its impulse is dropped.
+    rows[swing].impulse = 1.0;
+    let desc = &r.joints.iter().next().unwrap().1.desc;
+    let (ia, ib) = (r.a.index as usize, r.b.index as usize);
+    let twist = Quat::from_rotation_x(0.1);
+    r.set.rotation[ib] =
+        (r.set.rotation[ia] * desc.frame_a.rotation * twist * desc.frame_b.rotation.conjugate())
+            .normalize();
+    let (_, j) = r.joints.iter().next().unwrap();
+    refresh_joint(&jr, j, &r.set, &bodies, &mut rows, &mut blocks);
+    assert_eq!(rows[swing].ang_b, Vec3::ZERO);
+    assert_eq!((rows[swing].inv_k, rows[swing].impulse), (0.0, 0.0));
+    let (_, fresh, _) = prepare(&r, &bodies);
+    assert_same_rows(&fresh, &rows, "back to no swing");
+    // The twist rows measure the twist: 0.2 - 0.1 to the upper limit.
+    let upper = rows.iter().find(|row| row.slot == 13).unwrap();
+    assert!((upper.c - 0.1).abs() < 1e-4, "twist row c = {}", upper.c);
+}
+
+#[test]
+fn a_singular_block_falls_back_to_rows_and_stays_finite() {
+    use crate::solver::joints::{solve, JointScratch};
+    use crate::solver::Softness;
+    use carom_collision::math::Mat3;
+    // A fixed joint between two bodies whose rotation the solver cannot change (zero inverse
+    // inertia): the rotation block's K is zero.
+    let mut r = rig(JointKind::Fixed, Vec3::ZERO);
+    let mut bodies = Vec::new();
+    integrate::load(&r.set, &mut bodies);
+    for b in bodies.iter_mut() {
+        b.inv_i = Mat3::ZERO;
+        b.v = Vec3::new(0.3, -0.2, 0.1);
+        b.w = Vec3::new(1.0, 2.0, -0.5);
+    }
+    moved(&mut r, Quat::from_rotation_z(0.3));
+    let (jr, rows, blocks) = prepare(&r, &bodies);
+    assert_eq!(blocks.len(), 2);
+    assert!(blocks[0].valid, "the point block has the masses");
+    assert!(!blocks[1].valid, "the rotation block is singular");
+    assert!(rows[3..].iter().all(|row| row.inv_k == 0.0));
+    let mut s = JointScratch {
+        joints: vec![jr],
+        rows,
+        blocks,
+    };
+    let soft = Softness::new(60.0, 2.0, 1.0 / 240.0);
+    let w0: Vec<Vec3> = bodies.iter().map(|b| b.w).collect();
+    for use_bias in [true, false] {
+        solve(&mut s, &mut bodies, soft, 240.0, use_bias);
+    }
+    for (b, w) in bodies.iter().zip(w0) {
+        assert!(b.v.is_finite() && b.w.is_finite());
+        assert_eq!(b.w, w, "no angular change without inverse inertia");
+    }
+    // The point rows did act.
+    assert!(s.rows[..3].iter().all(|row| row.impulse.is_finite()));
+    assert!(s.rows[..3].iter().any(|row| row.impulse != 0.0));
+}
