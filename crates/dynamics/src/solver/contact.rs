@@ -32,6 +32,15 @@ pub(crate) struct ContactRow {
 }
 
 impl ContactRow {
+    /// A zero row: no mass, so its impulse stays zero.
+    pub const ZERO: ContactRow = ContactRow {
+        ang_a: Vec3::ZERO,
+        ang_b: Vec3::ZERO,
+        inv_ang_a: Vec3::ZERO,
+        inv_ang_b: Vec3::ZERO,
+        mass: 0.0,
+    };
+
     fn new(a: &SolverBody, b: &SolverBody, ra: Vec3, rb: Vec3, d: Vec3) -> ContactRow {
         let (ang_a, ang_b) = (ra.cross(d), rb.cross(d));
         let (inv_ang_a, inv_ang_b) = (a.inv_i * ang_a, b.inv_i * ang_b);
@@ -107,6 +116,40 @@ pub(crate) struct ContactConstraint {
     pub len: usize,
 }
 
+impl PointConstraint {
+    /// An empty point (zero rows and impulses).
+    pub const ZERO: PointConstraint = PointConstraint {
+        normal_row: ContactRow::ZERO,
+        tangent_rows: [ContactRow::ZERO; 2],
+        separation: 0.0,
+        relative_velocity: 0.0,
+        normal_impulse: 0.0,
+        tangent_impulse: [0.0; 2],
+        push_impulse: 0.0,
+        max_normal_impulse: 0.0,
+    };
+}
+
+impl ContactConstraint {
+    /// A constraint without points (all zero): the padding lanes of the SIMD solve.
+    pub const EMPTY: ContactConstraint = ContactConstraint {
+        a: 0,
+        b: 0,
+        manifold: 0,
+        normal: Vec3::ZERO,
+        tangent: [Vec3::ZERO; 2],
+        friction: 0.0,
+        restitution: 0.0,
+        softness: Softness {
+            bias_rate: 0.0,
+            mass_scale: 0.0,
+            impulse_scale: 0.0,
+        },
+        points: [PointConstraint::ZERO; MAX_MANIFOLD_POINTS],
+        len: 0,
+    };
+}
+
 impl PairConstraint for ContactConstraint {
     fn bodies(&self) -> (usize, usize) {
         (self.a, self.b)
@@ -132,12 +175,15 @@ pub(crate) struct ContactScratch {
     colour: ColourScratch,
 }
 
-/// Builds the constraints of the manifolds that touch an awake dynamic body into
-/// `scratch.cons`, already in colour order (module `coloring`), with the colour ranges in
-/// `scratch.colouring.ranges`. `impulse_in` scales the stored impulses (per-step units) to
-/// the solver's units (0 disables warm start). The manifolds are coloured first and each
-/// constraint is built once, at its place: no reordering copy of the (large) constraints.
-/// Allocates only when a buffer of `scratch` must grow.
+/// Builds the constraints of the manifolds that touch an awake dynamic body, in colour
+/// order (module `coloring`), with the colour ranges in `scratch.colouring.ranges`.
+/// Scalar (`simd` false): all of them into `scratch.cons`. SIMD: the colours but the
+/// overflow one straight into the lanes of `scratch.wide` (`contact_simd::fill`), the
+/// overflow colour into `scratch.cons`. `impulse_in` scales the stored impulses (per-step
+/// units) to the solver's units (0 disables warm start). The manifolds are coloured first
+/// and each constraint is built once, at its place: no reordering copy of the (large)
+/// constraints. Allocates only when a buffer of `scratch` must grow.
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn prepare(
     manifolds: &[ContactManifold],
     set: &BodySet,
@@ -145,15 +191,16 @@ pub(crate) fn prepare(
     impulse_in: Real,
     soft: Softness,
     static_soft: Softness,
+    simd: bool,
     scratch: &mut ContactScratch,
 ) {
     let ContactScratch {
         cons,
         colouring,
+        wide,
         selected,
         pairs,
         colour,
-        ..
     } = scratch;
     selected.clear();
     pairs.clear();
@@ -172,9 +219,9 @@ pub(crate) fn prepare(
         colour,
         colouring,
     );
-    cons.clear();
-    cons.extend(colouring.order.iter().map(|&k| {
-        let m_index = selected[k];
+    let order = &colouring.order;
+    let make = |k: usize| {
+        let m_index = selected[order[k]];
         prepare_one(
             &manifolds[m_index],
             m_index,
@@ -184,7 +231,13 @@ pub(crate) fn prepare(
             soft,
             static_soft,
         )
-    }));
+    };
+    if simd {
+        super::contact_simd::fill(wide, cons, &colouring.ranges, bodies, make);
+    } else {
+        cons.clear();
+        cons.extend((0..order.len()).map(make));
+    }
 }
 
 /// The constraint of manifold `m` (index `m_index`), which touches an awake dynamic body.

@@ -165,6 +165,7 @@ pub(crate) struct StepContext<'a> {
 /// deltas since the start of the step (soft step), or the split-impulse pseudo-velocities
 /// (sequential impulses).
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[repr(C)]
 pub(crate) struct SolverBody {
     pub v: Vec3,
     pub w: Vec3,
@@ -177,6 +178,26 @@ pub(crate) struct SolverBody {
 }
 
 impl SolverBody {
+    /// `v, w, dp, dq` as three rows of four scalars (the SIMD gather transposes them).
+    /// `repr(C)` keeps the four vectors adjacent, so this is three plain loads.
+    #[inline(always)]
+    pub fn state(&self) -> [[Real; 4]; 3] {
+        let (v, w, p, q) = (self.v, self.w, self.dp, self.dq);
+        [
+            [v.x, v.y, v.z, w.x],
+            [w.y, w.z, p.x, p.y],
+            [p.z, q.x, q.y, q.z],
+        ]
+    }
+
+    /// Sets `v` and `w` from the first rows of [`SolverBody::state`] (the last two scalars
+    /// of the second row are ignored).
+    #[inline(always)]
+    pub fn set_velocities(&mut self, r0: [Real; 4], r1: [Real; 4]) {
+        self.v = Vec3::new(r0[0], r0[1], r0[2]);
+        self.w = Vec3::new(r0[3], r1[0], r1[1]);
+    }
+
     /// Velocity of the material point at lever arm `r`.
     #[inline]
     pub fn point_velocity(&self, r: Vec3) -> Vec3 {

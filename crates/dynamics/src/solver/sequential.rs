@@ -30,6 +30,7 @@ pub(crate) fn step(ctx: &mut StepContext) {
         warm,
         Softness::RIGID,
         Softness::RIGID,
+        false,
         scratch,
     );
     let (cons, ranges) = (&mut scratch.cons, &scratch.colouring.ranges[..]);

@@ -38,6 +38,7 @@ pub(crate) fn step(ctx: &mut StepContext) {
     };
     let (soft, static_soft) = contact::softness_pair(&p, h);
     let scratch = &mut *ctx.scratch;
+    let simd = p.simd;
     contact::prepare(
         ctx.manifolds,
         ctx.set,
@@ -45,17 +46,9 @@ pub(crate) fn step(ctx: &mut StepContext) {
         warm,
         soft,
         static_soft,
+        simd,
         scratch,
     );
-    let simd = p.simd;
-    if simd {
-        contact_simd::build(
-            &scratch.cons,
-            &scratch.colouring.ranges,
-            ctx.bodies,
-            &mut scratch.wide,
-        );
-    }
     let (cons, ranges, wide) = (
         &mut scratch.cons,
         &scratch.colouring.ranges[..],
@@ -114,7 +107,7 @@ pub(crate) fn step(ctx: &mut StepContext) {
             |c, a, b| contact_simd::apply_restitution(c, a, b, threshold),
             |c, a, b| contact::apply_restitution(c, a, b, threshold),
         );
-        contact_simd::write_back(wide, cons);
+        contact_simd::store(wide, ctx.manifolds, n as Real);
     } else {
         solve_coloured(cons, ranges, ctx.bodies, par, min, |c, a, b| {
             contact::apply_restitution(c, a, b, threshold)
