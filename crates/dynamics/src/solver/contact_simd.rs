@@ -276,10 +276,14 @@ impl Bodies {
     /// # Safety
     /// No other live reference may touch the dynamic bodies of `c` during the call.
     #[inline(always)]
-    unsafe fn run<F>(self, c: &mut WideConstraint, f: &F)
+    unsafe fn run<F, A>(self, c: &mut WideConstraint, f: &F, active: &A)
     where
         F: Fn(&mut WideConstraint, &mut WideBody, &mut WideBody),
+        A: Fn(&WideConstraint) -> bool,
     {
+        if !active(c) {
+            return;
+        }
         let all = std::slice::from_raw_parts(self.ptr as *const SolverBody, self.len);
         let mut a = gather(all, &c.a, c.inv_m_a);
         let mut b = gather(all, &c.b, c.inv_m_b);
@@ -304,6 +308,32 @@ pub(crate) fn solve<F, S>(
     F: Fn(&mut WideConstraint, &mut WideBody, &mut WideBody) + Sync,
     S: Fn(&mut ContactConstraint, &mut SolverBody, &mut SolverBody) + Sync,
 {
+    solve_active(
+        wide,
+        cons,
+        bodies,
+        (parallel, min_batch),
+        |_| true,
+        wide_fn,
+        scalar_fn,
+    );
+}
+
+/// [`solve`] on the wide constraints for which `active` holds; the others are skipped
+/// without gathering their bodies (e.g. restitution on constraints without restitution).
+pub(crate) fn solve_active<A, F, S>(
+    wide: &mut WideScratch,
+    cons: &mut [ContactConstraint],
+    bodies: &mut [SolverBody],
+    (parallel, min_batch): (bool, usize),
+    active: A,
+    wide_fn: F,
+    scalar_fn: S,
+) where
+    A: Fn(&WideConstraint) -> bool + Sync,
+    F: Fn(&mut WideConstraint, &mut WideBody, &mut WideBody) + Sync,
+    S: Fn(&mut ContactConstraint, &mut SolverBody, &mut SolverBody) + Sync,
+{
     for r in &wide.ranges {
         let chunk = &mut wide.cons[r.clone()];
         let shared = Bodies {
@@ -311,12 +341,12 @@ pub(crate) fn solve<F, S>(
             len: bodies.len(),
         };
         let go_parallel = parallel && chunk.len() * LANES >= min_batch.max(2);
-        if go_parallel && solve_parallel(chunk, shared, &wide_fn) {
+        if go_parallel && solve_parallel(chunk, shared, &wide_fn, &active) {
             continue;
         }
         for c in chunk.iter_mut() {
             // SAFETY: `shared` is the only access to `bodies` here; one constraint at a time.
-            unsafe { shared.run(c, &wide_fn) };
+            unsafe { shared.run(c, &wide_fn, &active) };
         }
     }
     let overflow = wide.overflow.clone();
@@ -324,9 +354,10 @@ pub(crate) fn solve<F, S>(
 }
 
 #[cfg(feature = "parallel")]
-fn solve_parallel<F>(chunk: &mut [WideConstraint], shared: Bodies, f: &F) -> bool
+fn solve_parallel<F, A>(chunk: &mut [WideConstraint], shared: Bodies, f: &F, active: &A) -> bool
 where
     F: Fn(&mut WideConstraint, &mut WideBody, &mut WideBody) + Sync,
+    A: Fn(&WideConstraint) -> bool + Sync,
 {
     use rayon::prelude::*;
     if rayon::current_num_threads() < 2 {
@@ -337,12 +368,12 @@ where
     chunk
         .par_iter_mut()
         .with_min_len(16)
-        .for_each(|c| unsafe { shared.run(c, f) });
+        .for_each(|c| unsafe { shared.run(c, f, active) });
     true
 }
 
 #[cfg(not(feature = "parallel"))]
-fn solve_parallel<F>(_: &mut [WideConstraint], _: Bodies, _: &F) -> bool {
+fn solve_parallel<F, A>(_: &mut [WideConstraint], _: Bodies, _: &F, _: &A) -> bool {
     false
 }
 
@@ -427,6 +458,12 @@ pub(crate) fn solve_soft(
         p.normal_impulse = new;
         p.max_normal_impulse = p.max_normal_impulse.max(new);
     }
+}
+
+/// Whether any lane has restitution: the restitution pass skips the others entirely, as
+/// `contact::apply_restitution` returns at once for a constraint without restitution.
+pub(crate) fn has_restitution(c: &WideConstraint) -> bool {
+    c.restitution.simd_ne(W::splat(0.0)).any()
 }
 
 /// Restitution pass (`b2ApplyRestitution`), as `contact::apply_restitution` in every lane:

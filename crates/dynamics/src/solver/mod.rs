@@ -28,8 +28,15 @@ mod timing;
 
 pub use timing::StepTimings;
 
-/// The solver's reusable buffers, owned by the world (see [`contact::ContactScratch`]).
-pub(crate) type SolverScratch = contact::ContactScratch;
+/// The solver's reusable buffers, owned by the world and cleared, not freed, from step to
+/// step (see [`contact::ContactScratch`]).
+#[derive(Debug, Clone, Default)]
+pub(crate) struct SolverScratch {
+    /// Contact constraints and their colouring.
+    pub contacts: contact::ContactScratch,
+    /// Per-step constants of the moving bodies' integration.
+    pub terms: Vec<crate::integrate::BodyTerms>,
+}
 
 use crate::body_set::BodySet;
 use crate::contact::ContactManifold;
