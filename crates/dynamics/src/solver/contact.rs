@@ -233,7 +233,8 @@ pub(crate) fn prepare(
         )
     };
     if simd {
-        super::contact_simd::fill(wide, cons, &colouring.ranges, bodies, make);
+        let points = |k: usize| manifolds[selected[order[k]]].points().len();
+        super::contact_simd::fill(wide, cons, &colouring.ranges, bodies, points, make);
     } else {
         cons.clear();
         cons.extend((0..order.len()).map(make));

@@ -141,16 +141,23 @@ impl WideConstraint {
 }
 
 /// Builds the constraints of a step: `make(k)` prepares the constraint at position `k` of
-/// the colour order; `ranges` are the colour ranges of that order, the last being the
-/// overflow colour. The constraints of each colour but the last go four at a time, in colour
-/// order, into the lanes of `out.cons` (reusing last step's wide constraints); the overflow
-/// colour's go to `cons` (cleared first), and `out.overflow` is their range there. Allocates
-/// only when a buffer must grow.
+/// the colour order, which will have `points(k)` points; `ranges` are the colour ranges of
+/// that order, the last being the overflow colour. The constraints of each colour but the
+/// last go four at a time into the lanes of `out.cons` (reusing last step's wide
+/// constraints); the overflow colour's go to `cons` (cleared first), and `out.overflow` is
+/// their range there. Allocates only when a buffer must grow.
+///
+/// Inside a colour the constraints are grouped by point count (four-point ones first, in
+/// colour order within a count): a wide constraint solves as many points as its fullest
+/// lane, so mixing a one-point lane with a four-point lane wastes three points of work. The
+/// constraints of a colour share no dynamic body, so their order inside the colour does not
+/// change any result (and depends only on the colour order, not on the thread count).
 pub(crate) fn fill(
     out: &mut WideScratch,
     cons: &mut Vec<ContactConstraint>,
     ranges: &[Range<usize>],
     bodies: &[SolverBody],
+    points: impl Fn(usize) -> usize,
     mut make: impl FnMut(usize) -> ContactConstraint,
 ) {
     cons.clear();
@@ -160,27 +167,33 @@ pub(crate) fn fill(
         out.overflow = 0..0;
         return;
     };
+    let bucket = |k: usize| points(k).clamp(1, MAX_MANIFOLD_POINTS);
     let mut used = 0;
     for r in colours {
         let start = used;
-        for group in r.clone().step_by(LANES) {
-            if used == out.cons.len() {
-                out.cons.push(WideConstraint::empty());
-            }
-            let w = &mut out.cons[used];
-            let mut len = 0;
-            for l in 0..LANES {
-                let k = group + l;
-                if k < r.end {
-                    let c = make(k);
-                    len = len.max(c.len);
-                    w.set_lane(l, Some(&c), bodies);
-                } else {
-                    w.set_lane(l, None, bodies);
+        // Lane of the next constraint in the current wide constraint `used - 1`.
+        let mut lane = LANES;
+        for count in (1..=MAX_MANIFOLD_POINTS).rev() {
+            for k in r.clone().filter(|&k| bucket(k) == count) {
+                if lane == LANES {
+                    if used == out.cons.len() {
+                        out.cons.push(WideConstraint::empty());
+                    }
+                    out.cons[used].len = 0;
+                    used += 1;
+                    lane = 0;
                 }
+                let w = &mut out.cons[used - 1];
+                let c = make(k);
+                w.len = w.len.max(c.len);
+                w.set_lane(lane, Some(&c), bodies);
+                lane += 1;
             }
-            w.len = len;
-            used += 1;
+        }
+        if used > start {
+            for l in lane..LANES {
+                out.cons[used - 1].set_lane(l, None, bodies);
+            }
         }
         out.ranges.push(start..used);
     }
@@ -201,14 +214,17 @@ pub(crate) fn build(
     out: &mut WideScratch,
 ) {
     let mut scratch = Vec::new();
+    let points = |k: usize| cons[k].len;
     let Some((overflow, colours)) = ranges.split_last() else {
-        fill(out, &mut scratch, ranges, bodies, |k| cons[k].clone());
+        fill(out, &mut scratch, ranges, bodies, points, |k| {
+            cons[k].clone()
+        });
         return;
     };
     // The overflow colour is left out of the lanes and kept in `cons` by range.
     let mut rs: Vec<Range<usize>> = colours.to_vec();
     rs.push(overflow.start..overflow.start);
-    fill(out, &mut scratch, &rs, bodies, |k| cons[k].clone());
+    fill(out, &mut scratch, &rs, bodies, points, |k| cons[k].clone());
     out.overflow = overflow.clone();
 }
 

@@ -305,10 +305,18 @@ fn fill_writes_every_lane_and_overwrites_stale_ones() {
     ] {
         let (bodies, cons) = scene(&mut rng, count);
         let made = std::cell::Cell::new(0);
-        fill(&mut wide, &mut overflow_cons, &ranges, &bodies, |k| {
-            made.set(made.get() + 1);
-            cons[k].clone()
-        });
+        let points = |k: usize| cons[k].len;
+        fill(
+            &mut wide,
+            &mut overflow_cons,
+            &ranges,
+            &bodies,
+            points,
+            |k| {
+                made.set(made.get() + 1);
+                cons[k].clone()
+            },
+        );
         assert_eq!(made.get(), count, "each constraint is prepared once");
         let (overflow, colours) = ranges.split_last().unwrap();
         assert_eq!(wide.ranges.len(), colours.len());
@@ -321,11 +329,13 @@ fn fill_writes_every_lane_and_overwrites_stale_ones() {
         );
         for (r, wr) in colours.iter().zip(&wide.ranges) {
             assert_eq!(wr.len(), r.len().div_ceil(LANES));
+            // Grouped by point count, most points first, colour order within a count.
+            let mut expected: Vec<usize> = r.clone().collect();
+            expected.sort_by_key(|&k| std::cmp::Reverse(cons[k].len));
             for (g, w) in wide.cons[wr.clone()].iter().enumerate() {
                 let mut len = 0;
                 for l in 0..LANES {
-                    let k = r.start + g * LANES + l;
-                    let c = (k < r.end).then(|| &cons[k]);
+                    let c = expected.get(g * LANES + l).map(|&k| &cons[k]);
                     len = len.max(c.map_or(0, |c| c.len));
                     assert_lane(w, l, c, &bodies);
                 }
@@ -365,9 +375,15 @@ fn store_matches_the_scalar_store() {
         .collect();
     let mut wide = WideScratch::default();
     let mut overflow = Vec::new();
-    fill(&mut wide, &mut overflow, &[0..10, 10..10], &bodies, |k| {
-        cons[k].clone()
-    });
+    let points = |k: usize| cons[k].len;
+    fill(
+        &mut wide,
+        &mut overflow,
+        &[0..10, 10..10],
+        &bodies,
+        points,
+        |k| cons[k].clone(),
+    );
     let (mut m_wide, mut m_scalar) = (manifolds.clone(), manifolds);
     store(&wide, &mut m_wide, 4.0);
     contact::store(&cons, &mut m_scalar, 4.0);
