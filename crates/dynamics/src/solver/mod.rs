@@ -185,16 +185,16 @@ pub(crate) struct SolverBody {
 }
 
 impl SolverBody {
-    /// `v, w, dp, dq` as three rows of four scalars (the SIMD gather transposes them).
-    /// `repr(C)` keeps the four vectors adjacent, so this is three plain loads.
+    /// `v, w, dp, dq` as three rows of four scalars (the SIMD gather transposes them):
+    /// `[v.x, v.y, v.z, w.x], [w.y, w.z, dp.x, dp.y], [dp.z, dq.x, dq.y, dq.z]`. `repr(C)`
+    /// keeps the four vectors adjacent at the start of the struct (checked at compile time
+    /// below), so this is three plain vector loads.
     #[inline(always)]
     pub fn state(&self) -> [[Real; 4]; 3] {
-        let (v, w, p, q) = (self.v, self.w, self.dp, self.dq);
-        [
-            [v.x, v.y, v.z, w.x],
-            [w.y, w.z, p.x, p.y],
-            [p.z, q.x, q.y, q.z],
-        ]
+        // SAFETY: `SolverBody` is `repr(C)` and starts with the twelve scalars of `v, w, dp,
+        // dq` without padding (checked at compile time below); `[[Real; 4]; 3]` has the same size and
+        // no stricter alignment than `Real`, and every bit pattern is a valid `Real`.
+        unsafe { std::ptr::read_unaligned(self as *const SolverBody as *const [[Real; 4]; 3]) }
     }
 
     /// Sets `v` and `w` from the first rows of [`SolverBody::state`] (the last two scalars
@@ -211,6 +211,17 @@ impl SolverBody {
         self.v + self.w.cross(r)
     }
 }
+
+// [`SolverBody::state`] reads `v, w, dp, dq` as twelve consecutive scalars from the start.
+const _: () = {
+    use std::mem::{offset_of, size_of};
+    let r = size_of::<Real>();
+    assert!(size_of::<Vec3>() == 3 * r);
+    assert!(offset_of!(SolverBody, v) == 0);
+    assert!(offset_of!(SolverBody, w) == 3 * r);
+    assert!(offset_of!(SolverBody, dp) == 6 * r);
+    assert!(offset_of!(SolverBody, dq) == 9 * r);
+};
 
 /// Soft-constraint coefficients (Box2D v3's `b2Softness`, from Catto's "Solver2D"): a spring
 /// of frequency `hertz` and damping ratio `zeta` integrated implicitly over a step `h`.
