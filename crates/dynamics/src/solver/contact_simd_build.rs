@@ -4,8 +4,8 @@
 //! The constraints of every colour but the overflow one are written straight into their
 //! lanes as they are prepared ([`fill`]): no scalar constraint array is built for them and
 //! transposed afterwards, and the wide constraints of the last step are overwritten in
-//! place (every field of every lane, padding included), so a step neither zeroes nor copies
-//! the (large) constraint arrays. Box2D v3 prepares its SIMD constraints the same way
+//! place (every field of every lane that the solve reads, padding included), so a step
+//! neither zeroes nor copies the (large) constraint arrays. Box2D v3 prepares its SIMD constraints the same way
 //! (`b2PrepareContactsTask` writes `b2ContactConstraintSIMD` lanes directly).
 
 use super::{WideConstraint, WidePoint, WideRow, WideScratch, LANES, NONE, V3, W};
@@ -105,7 +105,9 @@ impl WideConstraint {
     }
 
     /// Lane `l` becomes constraint `c` (whose bodies are `bodies[c.a]`, `bodies[c.b]`), or a
-    /// padding lane (zero rows, no bodies) for `None`. Every field of the lane is written.
+    /// padding lane (zero rows, no bodies) for `None`. Every field of the lane is written but
+    /// the points from `c.len` on: [`WideConstraint::pad_points`] zeroes those the solve
+    /// reads once the group is complete.
     fn set_lane(&mut self, l: usize, c: Option<&ContactConstraint>, bodies: &[SolverBody]) {
         let c = c.unwrap_or(&ContactConstraint::EMPTY);
         let pad = c.len == 0;
@@ -134,8 +136,20 @@ impl WideConstraint {
         put(&mut self.bias_rate, l, c.softness.bias_rate);
         put(&mut self.mass_scale, l, c.softness.mass_scale);
         put(&mut self.impulse_scale, l, c.softness.impulse_scale);
-        for (k, wp) in self.points.iter_mut().enumerate() {
+        for (k, wp) in self.points[..c.len].iter_mut().enumerate() {
             wp.set_lane(l, c, k);
+        }
+    }
+
+    /// Zeroes the points `lens[l]..len` of every lane `l`, which the solve reads (it runs
+    /// `len` points in every lane). Points from `len` on are never read and keep whatever
+    /// they held: with the constraints of a colour grouped by point count, most groups have
+    /// lanes of equal length, and a group of one-point lanes writes one point instead of four.
+    fn pad_points(&mut self) {
+        for l in 0..LANES {
+            for k in self.lens[l]..self.len {
+                self.points[k].set_lane(l, &ContactConstraint::EMPTY, k);
+            }
         }
     }
 }
@@ -198,6 +212,9 @@ pub(crate) fn fill(
         out.ranges.push(start..used);
     }
     out.cons.truncate(used);
+    for w in &mut out.cons {
+        w.pad_points();
+    }
     cons.extend(overflow.clone().map(make));
     out.overflow = 0..cons.len();
 }
