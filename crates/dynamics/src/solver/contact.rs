@@ -220,9 +220,10 @@ pub(crate) fn prepare(
         colouring,
     );
     let order = &colouring.order;
-    let make = |k: usize| {
+    let make = |k: usize, out: &mut ContactConstraint| {
         let m_index = selected[order[k]];
         prepare_one(
+            out,
             &manifolds[m_index],
             m_index,
             set,
@@ -237,13 +238,20 @@ pub(crate) fn prepare(
         super::contact_simd::fill(wide, cons, &colouring.ranges, bodies, points, make);
     } else {
         cons.clear();
-        cons.extend((0..order.len()).map(make));
+        cons.extend((0..order.len()).map(|k| {
+            let mut c = ContactConstraint::EMPTY;
+            make(k, &mut c);
+            c
+        }));
     }
 }
 
-/// The constraint of manifold `m` (index `m_index`), which touches an awake dynamic body.
+/// Writes the constraint of manifold `m` (index `m_index`), which touches an awake dynamic
+/// body, into `out`: every field and the points `..len`; the points from `len` on are left
+/// as they were (nothing reads them), so a reused `out` is neither zeroed nor copied.
 #[allow(clippy::too_many_arguments)]
 fn prepare_one(
+    out: &mut ContactConstraint,
     m: &ContactManifold,
     m_index: usize,
     set: &BodySet,
@@ -251,57 +259,53 @@ fn prepare_one(
     impulse_in: Real,
     soft: Softness,
     static_soft: Softness,
-) -> ContactConstraint {
+) {
     let (a, b) = (m.body_a.index as usize, m.body_b.index as usize);
     let (ba, bb) = (&bodies[a], &bodies[b]);
     let (pose_a, pose_b) = (set.pose_of(a), set.pose_of(b));
     let (com_a, com_b) = (set.position[a], set.position[b]);
     let n = m.normal.normalize();
-    let mut points = [PointConstraint::default(); MAX_MANIFOLD_POINTS];
+    let len = m.points().len();
     let mut arms = [(Vec3::ZERO, Vec3::ZERO); MAX_MANIFOLD_POINTS];
     let mut centre_velocity = Vec3::ZERO;
-    for (k, p) in m.points().iter().enumerate() {
+    for ((p, pt), arm) in m.points().iter().zip(&mut out.points).zip(&mut arms) {
         let c = 0.5 * (pose_a.transform_point(p.local_a) + pose_b.transform_point(p.local_b));
         let (ra, rb) = (c - com_a, c - com_b);
-        arms[k] = (ra, rb);
+        *arm = (ra, rb);
         let dv = bb.point_velocity(rb) - ba.point_velocity(ra);
         centre_velocity += dv;
-        points[k] = PointConstraint {
-            normal_row: ContactRow::new(ba, bb, ra, rb, n),
-            separation: p.separation,
-            relative_velocity: dv.dot(n),
-            normal_impulse: p.normal_impulse * impulse_in,
-            tangent_impulse: [
-                p.tangent_impulse[0] * impulse_in,
-                p.tangent_impulse[1] * impulse_in,
-            ],
-            ..Default::default()
-        };
+        pt.normal_row = ContactRow::new(ba, bb, ra, rb, n);
+        pt.separation = p.separation;
+        pt.relative_velocity = dv.dot(n);
+        pt.normal_impulse = p.normal_impulse * impulse_in;
+        pt.tangent_impulse = [
+            p.tangent_impulse[0] * impulse_in,
+            p.tangent_impulse[1] * impulse_in,
+        ];
+        pt.push_impulse = 0.0;
+        pt.max_normal_impulse = 0.0;
     }
-    let t1 = friction_direction(m.tangent, n, centre_velocity / m.points().len() as Real);
+    let t1 = friction_direction(m.tangent, n, centre_velocity / len as Real);
     let t2 = n.cross(t1);
-    for (pt, &(ra, rb)) in points.iter_mut().zip(&arms).take(m.points().len()) {
+    for (pt, &(ra, rb)) in out.points[..len].iter_mut().zip(&arms) {
         pt.tangent_rows = [
             ContactRow::new(ba, bb, ra, rb, t1),
             ContactRow::new(ba, bb, ra, rb, t2),
         ];
     }
-    ContactConstraint {
-        a,
-        b,
-        manifold: m_index,
-        normal: n,
-        tangent: [t1, t2],
-        friction: m.friction,
-        restitution: m.restitution,
-        softness: if ba.dynamic && bb.dynamic {
-            soft
-        } else {
-            static_soft
-        },
-        points,
-        len: m.points().len(),
-    }
+    out.a = a;
+    out.b = b;
+    out.manifold = m_index;
+    out.normal = n;
+    out.tangent = [t1, t2];
+    out.friction = m.friction;
+    out.restitution = m.restitution;
+    out.softness = if ba.dynamic && bb.dynamic {
+        soft
+    } else {
+        static_soft
+    };
+    out.len = len;
 }
 
 /// The first friction direction: the cached one if still roughly in the tangent plane

@@ -154,7 +154,7 @@ impl WideConstraint {
     }
 }
 
-/// Builds the constraints of a step: `make(k)` prepares the constraint at position `k` of
+/// Builds the constraints of a step: `make(k, out)` prepares the constraint at position `k` of
 /// the colour order, which will have `points(k)` points; `ranges` are the colour ranges of
 /// that order, the last being the overflow colour. The constraints of each colour but the
 /// last go four at a time into the lanes of `out.cons` (reusing last step's wide
@@ -172,7 +172,7 @@ pub(crate) fn fill(
     ranges: &[Range<usize>],
     bodies: &[SolverBody],
     points: impl Fn(usize) -> usize,
-    mut make: impl FnMut(usize) -> ContactConstraint,
+    mut make: impl FnMut(usize, &mut ContactConstraint),
 ) {
     cons.clear();
     out.ranges.clear();
@@ -182,6 +182,8 @@ pub(crate) fn fill(
         return;
     };
     let bucket = |k: usize| points(k).clamp(1, MAX_MANIFOLD_POINTS);
+    // One constraint at a time is prepared here and written into its lane.
+    let mut c = ContactConstraint::EMPTY;
     let mut used = 0;
     for r in colours {
         let start = used;
@@ -198,7 +200,7 @@ pub(crate) fn fill(
                     lane = 0;
                 }
                 let w = &mut out.cons[used - 1];
-                let c = make(k);
+                make(k, &mut c);
                 w.len = w.len.max(c.len);
                 w.set_lane(lane, Some(&c), bodies);
                 lane += 1;
@@ -215,7 +217,11 @@ pub(crate) fn fill(
     for w in &mut out.cons {
         w.pad_points();
     }
-    cons.extend(overflow.clone().map(make));
+    cons.extend(overflow.clone().map(|k| {
+        let mut c = ContactConstraint::EMPTY;
+        make(k, &mut c);
+        c
+    }));
     out.overflow = 0..cons.len();
 }
 
@@ -233,15 +239,17 @@ pub(crate) fn build(
     let mut scratch = Vec::new();
     let points = |k: usize| cons[k].len;
     let Some((overflow, colours)) = ranges.split_last() else {
-        fill(out, &mut scratch, ranges, bodies, points, |k| {
-            cons[k].clone()
+        fill(out, &mut scratch, ranges, bodies, points, |k, c| {
+            *c = cons[k].clone()
         });
         return;
     };
     // The overflow colour is left out of the lanes and kept in `cons` by range.
     let mut rs: Vec<Range<usize>> = colours.to_vec();
     rs.push(overflow.start..overflow.start);
-    fill(out, &mut scratch, &rs, bodies, points, |k| cons[k].clone());
+    fill(out, &mut scratch, &rs, bodies, points, |k, c| {
+        *c = cons[k].clone()
+    });
     out.overflow = overflow.clone();
 }
 

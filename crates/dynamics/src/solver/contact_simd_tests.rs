@@ -313,9 +313,9 @@ fn fill_writes_every_lane_and_overwrites_stale_ones() {
             &ranges,
             &bodies,
             points,
-            |k| {
+            |k, c| {
                 made.set(made.get() + 1);
-                cons[k].clone()
+                *c = cons[k].clone();
             },
         );
         assert_eq!(made.get(), count, "each constraint is prepared once");
@@ -383,7 +383,7 @@ fn store_matches_the_scalar_store() {
         &[0..10, 10..10],
         &bodies,
         points,
-        |k| cons[k].clone(),
+        |k, c| *c = cons[k].clone(),
     );
     let (mut m_wide, mut m_scalar) = (manifolds.clone(), manifolds);
     store(&wide, &mut m_wide, 4.0);
