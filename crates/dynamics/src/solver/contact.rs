@@ -32,6 +32,15 @@ pub(crate) struct ContactRow {
 }
 
 impl ContactRow {
+    /// A zero row: no mass, so its impulse stays zero.
+    pub const ZERO: ContactRow = ContactRow {
+        ang_a: Vec3::ZERO,
+        ang_b: Vec3::ZERO,
+        inv_ang_a: Vec3::ZERO,
+        inv_ang_b: Vec3::ZERO,
+        mass: 0.0,
+    };
+
     fn new(a: &SolverBody, b: &SolverBody, ra: Vec3, rb: Vec3, d: Vec3) -> ContactRow {
         let (ang_a, ang_b) = (ra.cross(d), rb.cross(d));
         let (inv_ang_a, inv_ang_b) = (a.inv_i * ang_a, b.inv_i * ang_b);
@@ -107,6 +116,40 @@ pub(crate) struct ContactConstraint {
     pub len: usize,
 }
 
+impl PointConstraint {
+    /// An empty point (zero rows and impulses).
+    pub const ZERO: PointConstraint = PointConstraint {
+        normal_row: ContactRow::ZERO,
+        tangent_rows: [ContactRow::ZERO; 2],
+        separation: 0.0,
+        relative_velocity: 0.0,
+        normal_impulse: 0.0,
+        tangent_impulse: [0.0; 2],
+        push_impulse: 0.0,
+        max_normal_impulse: 0.0,
+    };
+}
+
+impl ContactConstraint {
+    /// A constraint without points (all zero): the padding lanes of the SIMD solve.
+    pub const EMPTY: ContactConstraint = ContactConstraint {
+        a: 0,
+        b: 0,
+        manifold: 0,
+        normal: Vec3::ZERO,
+        tangent: [Vec3::ZERO; 2],
+        friction: 0.0,
+        restitution: 0.0,
+        softness: Softness {
+            bias_rate: 0.0,
+            mass_scale: 0.0,
+            impulse_scale: 0.0,
+        },
+        points: [PointConstraint::ZERO; MAX_MANIFOLD_POINTS],
+        len: 0,
+    };
+}
+
 impl PairConstraint for ContactConstraint {
     fn bodies(&self) -> (usize, usize) {
         (self.a, self.b)
@@ -132,12 +175,15 @@ pub(crate) struct ContactScratch {
     colour: ColourScratch,
 }
 
-/// Builds the constraints of the manifolds that touch an awake dynamic body into
-/// `scratch.cons`, already in colour order (module `coloring`), with the colour ranges in
-/// `scratch.colouring.ranges`. `impulse_in` scales the stored impulses (per-step units) to
-/// the solver's units (0 disables warm start). The manifolds are coloured first and each
-/// constraint is built once, at its place: no reordering copy of the (large) constraints.
-/// Allocates only when a buffer of `scratch` must grow.
+/// Builds the constraints of the manifolds that touch an awake dynamic body, in colour
+/// order (module `coloring`), with the colour ranges in `scratch.colouring.ranges`.
+/// Scalar (`simd` false): all of them into `scratch.cons`. SIMD: the colours but the
+/// overflow one straight into the lanes of `scratch.wide` (`contact_simd::fill`), the
+/// overflow colour into `scratch.cons`. `impulse_in` scales the stored impulses (per-step
+/// units) to the solver's units (0 disables warm start). The manifolds are coloured first
+/// and each constraint is built once, at its place: no reordering copy of the (large)
+/// constraints. Allocates only when a buffer of `scratch` must grow.
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn prepare(
     manifolds: &[ContactManifold],
     set: &BodySet,
@@ -145,15 +191,16 @@ pub(crate) fn prepare(
     impulse_in: Real,
     soft: Softness,
     static_soft: Softness,
+    simd: bool,
     scratch: &mut ContactScratch,
 ) {
     let ContactScratch {
         cons,
         colouring,
+        wide,
         selected,
         pairs,
         colour,
-        ..
     } = scratch;
     selected.clear();
     pairs.clear();
@@ -172,10 +219,11 @@ pub(crate) fn prepare(
         colour,
         colouring,
     );
-    cons.clear();
-    cons.extend(colouring.order.iter().map(|&k| {
-        let m_index = selected[k];
+    let order = &colouring.order;
+    let make = |k: usize, out: &mut ContactConstraint| {
+        let m_index = selected[order[k]];
         prepare_one(
+            out,
             &manifolds[m_index],
             m_index,
             set,
@@ -184,12 +232,26 @@ pub(crate) fn prepare(
             soft,
             static_soft,
         )
-    }));
+    };
+    if simd {
+        let points = |k: usize| manifolds[selected[order[k]]].points().len();
+        super::contact_simd::fill(wide, cons, &colouring.ranges, bodies, points, make);
+    } else {
+        cons.clear();
+        cons.extend((0..order.len()).map(|k| {
+            let mut c = ContactConstraint::EMPTY;
+            make(k, &mut c);
+            c
+        }));
+    }
 }
 
-/// The constraint of manifold `m` (index `m_index`), which touches an awake dynamic body.
+/// Writes the constraint of manifold `m` (index `m_index`), which touches an awake dynamic
+/// body, into `out`: every field and the points `..len`; the points from `len` on are left
+/// as they were (nothing reads them), so a reused `out` is neither zeroed nor copied.
 #[allow(clippy::too_many_arguments)]
 fn prepare_one(
+    out: &mut ContactConstraint,
     m: &ContactManifold,
     m_index: usize,
     set: &BodySet,
@@ -197,57 +259,53 @@ fn prepare_one(
     impulse_in: Real,
     soft: Softness,
     static_soft: Softness,
-) -> ContactConstraint {
+) {
     let (a, b) = (m.body_a.index as usize, m.body_b.index as usize);
     let (ba, bb) = (&bodies[a], &bodies[b]);
     let (pose_a, pose_b) = (set.pose_of(a), set.pose_of(b));
     let (com_a, com_b) = (set.position[a], set.position[b]);
     let n = m.normal.normalize();
-    let mut points = [PointConstraint::default(); MAX_MANIFOLD_POINTS];
+    let len = m.points().len();
     let mut arms = [(Vec3::ZERO, Vec3::ZERO); MAX_MANIFOLD_POINTS];
     let mut centre_velocity = Vec3::ZERO;
-    for (k, p) in m.points().iter().enumerate() {
+    for ((p, pt), arm) in m.points().iter().zip(&mut out.points).zip(&mut arms) {
         let c = 0.5 * (pose_a.transform_point(p.local_a) + pose_b.transform_point(p.local_b));
         let (ra, rb) = (c - com_a, c - com_b);
-        arms[k] = (ra, rb);
+        *arm = (ra, rb);
         let dv = bb.point_velocity(rb) - ba.point_velocity(ra);
         centre_velocity += dv;
-        points[k] = PointConstraint {
-            normal_row: ContactRow::new(ba, bb, ra, rb, n),
-            separation: p.separation,
-            relative_velocity: dv.dot(n),
-            normal_impulse: p.normal_impulse * impulse_in,
-            tangent_impulse: [
-                p.tangent_impulse[0] * impulse_in,
-                p.tangent_impulse[1] * impulse_in,
-            ],
-            ..Default::default()
-        };
+        pt.normal_row = ContactRow::new(ba, bb, ra, rb, n);
+        pt.separation = p.separation;
+        pt.relative_velocity = dv.dot(n);
+        pt.normal_impulse = p.normal_impulse * impulse_in;
+        pt.tangent_impulse = [
+            p.tangent_impulse[0] * impulse_in,
+            p.tangent_impulse[1] * impulse_in,
+        ];
+        pt.push_impulse = 0.0;
+        pt.max_normal_impulse = 0.0;
     }
-    let t1 = friction_direction(m.tangent, n, centre_velocity / m.points().len() as Real);
+    let t1 = friction_direction(m.tangent, n, centre_velocity / len as Real);
     let t2 = n.cross(t1);
-    for (pt, &(ra, rb)) in points.iter_mut().zip(&arms).take(m.points().len()) {
+    for (pt, &(ra, rb)) in out.points[..len].iter_mut().zip(&arms) {
         pt.tangent_rows = [
             ContactRow::new(ba, bb, ra, rb, t1),
             ContactRow::new(ba, bb, ra, rb, t2),
         ];
     }
-    ContactConstraint {
-        a,
-        b,
-        manifold: m_index,
-        normal: n,
-        tangent: [t1, t2],
-        friction: m.friction,
-        restitution: m.restitution,
-        softness: if ba.dynamic && bb.dynamic {
-            soft
-        } else {
-            static_soft
-        },
-        points,
-        len: m.points().len(),
-    }
+    out.a = a;
+    out.b = b;
+    out.manifold = m_index;
+    out.normal = n;
+    out.tangent = [t1, t2];
+    out.friction = m.friction;
+    out.restitution = m.restitution;
+    out.softness = if ba.dynamic && bb.dynamic {
+        soft
+    } else {
+        static_soft
+    };
+    out.len = len;
 }
 
 /// The first friction direction: the cached one if still roughly in the tangent plane

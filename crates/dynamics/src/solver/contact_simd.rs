@@ -16,12 +16,18 @@
 //! physics; the grouping depends only on the colour order, never on the thread count.
 //! The lane type is selected from [`Real`] in one place ([`W`]): `f32x4` or `f64x4`.
 
-use super::coloring::{solve_coloured, COLOURS};
+use super::coloring::solve_coloured;
 use super::contact::ContactConstraint;
 use super::SolverBody;
 use crate::contact::MAX_MANIFOLD_POINTS;
-use carom_collision::math::{Real, Vec3};
+use carom_collision::math::Real;
 use std::ops::Range;
+
+#[path = "contact_simd_build.rs"]
+mod build;
+#[cfg(test)]
+pub(crate) use build::{build, write_back};
+pub(crate) use build::{fill, store};
 
 /// Maps a scalar type to its four-lane vector.
 pub(crate) trait Lanes {
@@ -46,7 +52,7 @@ pub(crate) const LANES: usize = 4;
 /// Lane body slot of a padding lane.
 const NONE: usize = usize::MAX;
 
-/// A vector of four lanes of [`Vec3`].
+/// A vector of four lanes of [`Vec3`](carom_collision::math::Vec3).
 #[derive(Debug, Clone, Copy, Default)]
 struct V3 {
     x: W,
@@ -55,17 +61,6 @@ struct V3 {
 }
 
 impl V3 {
-    /// Lane `l` is `f(l)`.
-    #[inline]
-    fn from_fn(f: impl Fn(usize) -> Vec3) -> V3 {
-        let v: [Vec3; LANES] = std::array::from_fn(f);
-        V3 {
-            x: W::new(v.map(|v| v.x)),
-            y: W::new(v.map(|v| v.y)),
-            z: W::new(v.map(|v| v.z)),
-        }
-    }
-
     /// Same order of operations as glam's `Vec3::dot`.
     #[inline(always)]
     fn dot(self, o: V3) -> W {
@@ -98,12 +93,6 @@ impl V3 {
             z: self.z * s,
         }
     }
-}
-
-/// Lane `l` is `f(l)`.
-#[inline]
-fn lanes(f: impl Fn(usize) -> Real) -> W {
-    W::new(std::array::from_fn(f))
 }
 
 /// Four [`super::contact::ContactRow`]s.
@@ -158,8 +147,14 @@ pub(crate) struct WideConstraint {
     /// Body slots of each lane (`NONE` for padding).
     a: [usize; LANES],
     b: [usize; LANES],
-    /// Index of each lane's constraint in the scalar constraints (`NONE` for padding).
-    source: [usize; LANES],
+    /// Whether the solve writes the lane's body back (dynamic bodies only: a static or
+    /// kinematic body may be shared by several lanes and threads, and is only read).
+    write_a: [bool; LANES],
+    write_b: [bool; LANES],
+    /// Manifold of each lane (`NONE` for padding), where `store` writes the impulses.
+    manifold: [usize; LANES],
+    /// Point count of each lane.
+    lens: [usize; LANES],
     inv_m_a: W,
     inv_m_b: W,
     normal: V3,
@@ -185,147 +180,70 @@ pub(crate) struct WideBody {
 }
 
 /// Gathers the bodies of `slots` into lanes (`b2GatherBodies`); padding lanes are a
-/// motionless static body.
-#[inline]
+/// motionless static body. Each body's `v, w, dp, dq` are twelve consecutive scalars
+/// ([`SolverBody::state`]), read as three four-wide rows and transposed with three 4×4
+/// transposes, which leave exactly the twelve lane vectors (`v.x … dq.z`).
+#[inline(always)]
 fn gather(bodies: &[SolverBody], slots: &[usize; LANES], inv_m: W) -> WideBody {
-    // Twelve scalars per lane (v, w, dp, dq), transposed into twelve lane vectors.
-    let mut t = [[0.0 as Real; LANES]; 12];
-    for (l, &s) in slots.iter().enumerate() {
+    let rows = slots.map(|s| {
         if s == NONE {
-            continue;
+            [[0.0; LANES]; 3]
+        } else {
+            bodies[s].state()
         }
-        let b = &bodies[s];
-        for (k, v) in [b.v, b.w, b.dp, b.dq].iter().enumerate() {
-            t[3 * k][l] = v.x;
-            t[3 * k + 1][l] = v.y;
-            t[3 * k + 2][l] = v.z;
-        }
-    }
-    let v3 = |k: usize| V3 {
-        x: W::new(t[3 * k]),
-        y: W::new(t[3 * k + 1]),
-        z: W::new(t[3 * k + 2]),
-    };
+    });
+    let t = |k: usize| W::transpose(rows.map(|r| W::new(r[k])));
+    let ([vx, vy, vz, wx], [wy, wz, px, py], [pz, qx, qy, qz]) = (t(0), t(1), t(2));
     WideBody {
-        v: v3(0),
-        w: v3(1),
-        dp: v3(2),
-        dq: v3(3),
+        v: V3 {
+            x: vx,
+            y: vy,
+            z: vz,
+        },
+        w: V3 {
+            x: wx,
+            y: wy,
+            z: wz,
+        },
+        dp: V3 {
+            x: px,
+            y: py,
+            z: pz,
+        },
+        dq: V3 {
+            x: qx,
+            y: qy,
+            z: qz,
+        },
         inv_m,
     }
 }
 
-/// Writes the velocities of the dynamic bodies of `slots` back (`b2ScatterBodies`).
+/// Writes the velocities of the lanes with `write[l]` (dynamic bodies) back
+/// (`b2ScatterBodies`): two 4×4 transposes give each lane's `v, w` (and its unchanged
+/// `dp.x, dp.y`) as two rows.
 ///
 /// # Safety
-/// `bodies` points to `len` solver bodies, and no other live reference touches the dynamic
-/// bodies of `slots` during the call (the colouring guarantees it for one colour).
-#[inline]
-unsafe fn scatter(body: &WideBody, bodies: *mut SolverBody, len: usize, slots: &[usize; LANES]) {
-    let [vx, vy, vz] = [body.v.x, body.v.y, body.v.z].map(|x| x.to_array());
-    let [wx, wy, wz] = [body.w.x, body.w.y, body.w.z].map(|x| x.to_array());
-    for (l, &s) in slots.iter().enumerate() {
-        if s == NONE {
+/// `bodies` points to `len` solver bodies, and no other live reference touches the bodies
+/// written during the call (the colouring guarantees it for one colour).
+#[inline(always)]
+unsafe fn scatter(
+    body: &WideBody,
+    bodies: *mut SolverBody,
+    len: usize,
+    slots: &[usize; LANES],
+    write: &[bool; LANES],
+) {
+    let r0 = W::transpose([body.v.x, body.v.y, body.v.z, body.w.x]);
+    let r1 = W::transpose([body.w.y, body.w.z, body.dp.x, body.dp.y]);
+    for l in 0..LANES {
+        if !write[l] {
             continue;
         }
+        let s = slots[l];
         assert!(s < len);
         let target = &mut *bodies.add(s);
-        if target.dynamic {
-            target.v = Vec3::new(vx[l], vy[l], vz[l]);
-            target.w = Vec3::new(wx[l], wy[l], wz[l]);
-        }
-    }
-}
-
-impl WideConstraint {
-    /// Transposes the constraints `cons[group]` (at most four, one colour) into lanes.
-    fn new(cons: &[ContactConstraint], group: Range<usize>, bodies: &[SolverBody]) -> Self {
-        debug_assert!(group.len() <= LANES);
-        let source: [usize; LANES] = std::array::from_fn(|l| {
-            if l < group.len() {
-                group.start + l
-            } else {
-                NONE
-            }
-        });
-        let con = |l: usize| (source[l] != NONE).then(|| &cons[source[l]]);
-        let real = |f: fn(&ContactConstraint) -> Real| lanes(|l| con(l).map_or(0.0, f));
-        let vec =
-            |f: &dyn Fn(&ContactConstraint) -> Vec3| V3::from_fn(|l| con(l).map_or(Vec3::ZERO, f));
-        let a = source.map(|s| if s == NONE { NONE } else { cons[s].a });
-        let b = source.map(|s| if s == NONE { NONE } else { cons[s].b });
-        let inv_m = |slots: &[usize; LANES]| {
-            lanes(|l| {
-                if slots[l] == NONE {
-                    0.0
-                } else {
-                    bodies[slots[l]].inv_m
-                }
-            })
-        };
-        let mut points = [WidePoint::default(); MAX_MANIFOLD_POINTS];
-        for (k, wp) in points.iter_mut().enumerate() {
-            let pt = |l: usize| con(l).filter(|c| k < c.len).map(|c| &c.points[k]);
-            let row = |f: fn(&super::contact::PointConstraint) -> &super::contact::ContactRow| {
-                let r = |l: usize| pt(l).map(f);
-                WideRow {
-                    ang_a: V3::from_fn(|l| r(l).map_or(Vec3::ZERO, |r| r.ang_a)),
-                    ang_b: V3::from_fn(|l| r(l).map_or(Vec3::ZERO, |r| r.ang_b)),
-                    inv_ang_a: V3::from_fn(|l| r(l).map_or(Vec3::ZERO, |r| r.inv_ang_a)),
-                    inv_ang_b: V3::from_fn(|l| r(l).map_or(Vec3::ZERO, |r| r.inv_ang_b)),
-                    mass: lanes(|l| r(l).map_or(0.0, |r| r.mass)),
-                }
-            };
-            let val =
-                |f: fn(&super::contact::PointConstraint) -> Real| lanes(|l| pt(l).map_or(0.0, f));
-            *wp = WidePoint {
-                normal_row: row(|p| &p.normal_row),
-                tangent_rows: [row(|p| &p.tangent_rows[0]), row(|p| &p.tangent_rows[1])],
-                separation: val(|p| p.separation),
-                relative_velocity: val(|p| p.relative_velocity),
-                normal_impulse: val(|p| p.normal_impulse),
-                tangent_impulse: [val(|p| p.tangent_impulse[0]), val(|p| p.tangent_impulse[1])],
-                max_normal_impulse: val(|p| p.max_normal_impulse),
-            };
-        }
-        WideConstraint {
-            a,
-            b,
-            source,
-            inv_m_a: inv_m(&a),
-            inv_m_b: inv_m(&b),
-            normal: vec(&|c| c.normal),
-            tangent: [vec(&|c| c.tangent[0]), vec(&|c| c.tangent[1])],
-            friction: real(|c| c.friction),
-            restitution: real(|c| c.restitution),
-            bias_rate: real(|c| c.softness.bias_rate),
-            mass_scale: real(|c| c.softness.mass_scale),
-            impulse_scale: real(|c| c.softness.impulse_scale),
-            points,
-            len: (0..LANES)
-                .filter_map(|l| con(l).map(|c| c.len))
-                .max()
-                .unwrap_or(0),
-        }
-    }
-
-    /// Copies the accumulated impulses of every lane back into its scalar constraint.
-    fn write_back(&self, cons: &mut [ContactConstraint]) {
-        for (l, &s) in self.source.iter().enumerate() {
-            if s == NONE {
-                continue;
-            }
-            let c = &mut cons[s];
-            for (k, p) in c.points[..c.len].iter_mut().enumerate() {
-                let wp = &self.points[k];
-                p.normal_impulse = wp.normal_impulse.to_array()[l];
-                p.tangent_impulse = [
-                    wp.tangent_impulse[0].to_array()[l],
-                    wp.tangent_impulse[1].to_array()[l],
-                ];
-                p.max_normal_impulse = wp.max_normal_impulse.to_array()[l];
-            }
-        }
+        target.set_velocities(r0[l].to_array(), r1[l].to_array());
     }
 }
 
@@ -338,41 +256,6 @@ pub(crate) struct WideScratch {
     pub ranges: Vec<Range<usize>>,
     /// The overflow colour, as a range of the scalar constraints.
     pub overflow: Range<usize>,
-}
-
-/// Groups the constraints of each colour (`ranges`, the last being the overflow colour) four
-/// at a time, in colour order, into `out`. Allocates only when a buffer must grow.
-pub(crate) fn build(
-    cons: &[ContactConstraint],
-    ranges: &[Range<usize>],
-    bodies: &[SolverBody],
-    out: &mut WideScratch,
-) {
-    out.cons.clear();
-    out.ranges.clear();
-    let Some((overflow, colours)) = ranges.split_last() else {
-        out.overflow = 0..0;
-        return;
-    };
-    debug_assert!(colours.len() <= COLOURS);
-    for r in colours {
-        let start = out.cons.len();
-        let mut k = r.start;
-        while k < r.end {
-            let end = (k + LANES).min(r.end);
-            out.cons.push(WideConstraint::new(cons, k..end, bodies));
-            k = end;
-        }
-        out.ranges.push(start..out.cons.len());
-    }
-    out.overflow = overflow.clone();
-}
-
-/// Copies the impulses of the wide constraints back into `cons` (before `contact::store`).
-pub(crate) fn write_back(wide: &WideScratch, cons: &mut [ContactConstraint]) {
-    for w in &wide.cons {
-        w.write_back(cons);
-    }
 }
 
 /// Raw access to the solver bodies while one colour is solved.
@@ -393,16 +276,20 @@ impl Bodies {
     /// # Safety
     /// No other live reference may touch the dynamic bodies of `c` during the call.
     #[inline(always)]
-    unsafe fn run<F>(self, c: &mut WideConstraint, f: &F)
+    unsafe fn run<F, A>(self, c: &mut WideConstraint, f: &F, active: &A)
     where
         F: Fn(&mut WideConstraint, &mut WideBody, &mut WideBody),
+        A: Fn(&WideConstraint) -> bool,
     {
+        if !active(c) {
+            return;
+        }
         let all = std::slice::from_raw_parts(self.ptr as *const SolverBody, self.len);
         let mut a = gather(all, &c.a, c.inv_m_a);
         let mut b = gather(all, &c.b, c.inv_m_b);
         f(c, &mut a, &mut b);
-        scatter(&a, self.ptr, self.len, &c.a);
-        scatter(&b, self.ptr, self.len, &c.b);
+        scatter(&a, self.ptr, self.len, &c.a, &c.write_a);
+        scatter(&b, self.ptr, self.len, &c.b, &c.write_b);
     }
 }
 
@@ -421,6 +308,32 @@ pub(crate) fn solve<F, S>(
     F: Fn(&mut WideConstraint, &mut WideBody, &mut WideBody) + Sync,
     S: Fn(&mut ContactConstraint, &mut SolverBody, &mut SolverBody) + Sync,
 {
+    solve_active(
+        wide,
+        cons,
+        bodies,
+        (parallel, min_batch),
+        |_| true,
+        wide_fn,
+        scalar_fn,
+    );
+}
+
+/// [`solve`] on the wide constraints for which `active` holds; the others are skipped
+/// without gathering their bodies (e.g. restitution on constraints without restitution).
+pub(crate) fn solve_active<A, F, S>(
+    wide: &mut WideScratch,
+    cons: &mut [ContactConstraint],
+    bodies: &mut [SolverBody],
+    (parallel, min_batch): (bool, usize),
+    active: A,
+    wide_fn: F,
+    scalar_fn: S,
+) where
+    A: Fn(&WideConstraint) -> bool + Sync,
+    F: Fn(&mut WideConstraint, &mut WideBody, &mut WideBody) + Sync,
+    S: Fn(&mut ContactConstraint, &mut SolverBody, &mut SolverBody) + Sync,
+{
     for r in &wide.ranges {
         let chunk = &mut wide.cons[r.clone()];
         let shared = Bodies {
@@ -428,12 +341,12 @@ pub(crate) fn solve<F, S>(
             len: bodies.len(),
         };
         let go_parallel = parallel && chunk.len() * LANES >= min_batch.max(2);
-        if go_parallel && solve_parallel(chunk, shared, &wide_fn) {
+        if go_parallel && solve_parallel(chunk, shared, &wide_fn, &active) {
             continue;
         }
         for c in chunk.iter_mut() {
             // SAFETY: `shared` is the only access to `bodies` here; one constraint at a time.
-            unsafe { shared.run(c, &wide_fn) };
+            unsafe { shared.run(c, &wide_fn, &active) };
         }
     }
     let overflow = wide.overflow.clone();
@@ -441,9 +354,10 @@ pub(crate) fn solve<F, S>(
 }
 
 #[cfg(feature = "parallel")]
-fn solve_parallel<F>(chunk: &mut [WideConstraint], shared: Bodies, f: &F) -> bool
+fn solve_parallel<F, A>(chunk: &mut [WideConstraint], shared: Bodies, f: &F, active: &A) -> bool
 where
     F: Fn(&mut WideConstraint, &mut WideBody, &mut WideBody) + Sync,
+    A: Fn(&WideConstraint) -> bool + Sync,
 {
     use rayon::prelude::*;
     if rayon::current_num_threads() < 2 {
@@ -454,12 +368,12 @@ where
     chunk
         .par_iter_mut()
         .with_min_len(16)
-        .for_each(|c| unsafe { shared.run(c, f) });
+        .for_each(|c| unsafe { shared.run(c, f, active) });
     true
 }
 
 #[cfg(not(feature = "parallel"))]
-fn solve_parallel<F>(_: &mut [WideConstraint], _: Bodies, _: &F) -> bool {
+fn solve_parallel<F, A>(_: &mut [WideConstraint], _: Bodies, _: &F, _: &A) -> bool {
     false
 }
 
@@ -544,6 +458,12 @@ pub(crate) fn solve_soft(
         p.normal_impulse = new;
         p.max_normal_impulse = p.max_normal_impulse.max(new);
     }
+}
+
+/// Whether any lane has restitution: the restitution pass skips the others entirely, as
+/// `contact::apply_restitution` returns at once for a constraint without restitution.
+pub(crate) fn has_restitution(c: &WideConstraint) -> bool {
+    c.restitution.simd_ne(W::splat(0.0)).any()
 }
 
 /// Restitution pass (`b2ApplyRestitution`), as `contact::apply_restitution` in every lane:

@@ -235,3 +235,165 @@ fn overflow_colour_is_solved_scalar() {
     super::super::coloring::solve_coloured(&mut cons2, &ranges, &mut bodies2, false, 1, scalar);
     compare(&bodies, &bodies2, &cons, &cons2);
 }
+
+/// Lane `l` of `w` holds exactly (bit for bit) constraint `c`, or is an empty padding lane.
+fn assert_lane(w: &WideConstraint, l: usize, c: Option<&ContactConstraint>, bodies: &[SolverBody]) {
+    let lane = |x: &W| x.as_array()[l];
+    let lane3 = |v: &V3| Vec3::new(lane(&v.x), lane(&v.y), lane(&v.z));
+    let empty = ContactConstraint::EMPTY;
+    let c_or = c.unwrap_or(&empty);
+    assert_eq!(w.manifold[l], c.map_or(NONE, |c| c.manifold));
+    assert_eq!(w.lens[l], c_or.len);
+    assert_eq!((w.a[l], w.b[l]), c.map_or((NONE, NONE), |c| (c.a, c.b)));
+    let dynamic = |s: usize| s != NONE && bodies[s].dynamic;
+    assert_eq!(
+        (w.write_a[l], w.write_b[l]),
+        (dynamic(w.a[l]), dynamic(w.b[l]))
+    );
+    let inv_m = |s: usize| if s == NONE { 0.0 } else { bodies[s].inv_m };
+    assert_eq!(lane(&w.inv_m_a).to_bits(), inv_m(w.a[l]).to_bits());
+    assert_eq!(lane(&w.inv_m_b).to_bits(), inv_m(w.b[l]).to_bits());
+    assert_eq!(lane3(&w.normal), c_or.normal);
+    assert_eq!(lane3(&w.tangent[0]), c_or.tangent[0]);
+    assert_eq!(lane3(&w.tangent[1]), c_or.tangent[1]);
+    assert_eq!(lane(&w.friction), c_or.friction);
+    assert_eq!(lane(&w.restitution), c_or.restitution);
+    assert_eq!(lane(&w.bias_rate), c_or.softness.bias_rate);
+    assert_eq!(lane(&w.mass_scale), c_or.softness.mass_scale);
+    assert_eq!(lane(&w.impulse_scale), c_or.softness.impulse_scale);
+    // Points from `w.len` on are never read (and may be stale).
+    for (k, wp) in w.points[..w.len].iter().enumerate() {
+        let p = if k < c_or.len {
+            c_or.points[k]
+        } else {
+            PointConstraint::ZERO
+        };
+        let rows = [
+            (&wp.normal_row, &p.normal_row),
+            (&wp.tangent_rows[0], &p.tangent_rows[0]),
+            (&wp.tangent_rows[1], &p.tangent_rows[1]),
+        ];
+        for (wr, r) in rows {
+            assert_eq!(lane3(&wr.ang_a), r.ang_a);
+            assert_eq!(lane3(&wr.ang_b), r.ang_b);
+            assert_eq!(lane3(&wr.inv_ang_a), r.inv_ang_a);
+            assert_eq!(lane3(&wr.inv_ang_b), r.inv_ang_b);
+            assert_eq!(lane(&wr.mass).to_bits(), r.mass.to_bits());
+        }
+        assert_eq!(lane(&wp.separation), p.separation);
+        assert_eq!(lane(&wp.relative_velocity), p.relative_velocity);
+        assert_eq!(lane(&wp.normal_impulse), p.normal_impulse);
+        assert_eq!(lane(&wp.tangent_impulse[0]), p.tangent_impulse[0]);
+        assert_eq!(lane(&wp.tangent_impulse[1]), p.tangent_impulse[1]);
+        assert_eq!(lane(&wp.max_normal_impulse), p.max_normal_impulse);
+    }
+}
+
+/// `fill` writes every colour but the overflow one into lanes, bit for bit, padding the
+/// last group of a colour, and keeps the overflow colour scalar. Run twice on the same
+/// buffers, the second time with fewer constraints and other values: nothing of the first
+/// run survives in the reused wide constraints.
+#[test]
+fn fill_writes_every_lane_and_overwrites_stale_ones() {
+    let mut rng = Rng(0x5eed);
+    let mut wide = WideScratch::default();
+    let mut overflow_cons = Vec::new();
+    for (count, ranges) in [
+        (11, vec![0..7, 7..9, 9..11]),
+        (5, vec![0..2, 2..3, 3..5]),
+        (3, vec![0..3, 3..3]),
+        (0, vec![Range { start: 0, end: 0 }]),
+    ] {
+        let (bodies, cons) = scene(&mut rng, count);
+        let made = std::cell::Cell::new(0);
+        let points = |k: usize| cons[k].len;
+        fill(
+            &mut wide,
+            &mut overflow_cons,
+            &ranges,
+            &bodies,
+            points,
+            |k, c| {
+                made.set(made.get() + 1);
+                *c = cons[k].clone();
+            },
+        );
+        assert_eq!(made.get(), count, "each constraint is prepared once");
+        let (overflow, colours) = ranges.split_last().unwrap();
+        assert_eq!(wide.ranges.len(), colours.len());
+        assert_eq!(
+            wide.cons.len(),
+            colours
+                .iter()
+                .map(|r| r.len().div_ceil(LANES))
+                .sum::<usize>()
+        );
+        for (r, wr) in colours.iter().zip(&wide.ranges) {
+            assert_eq!(wr.len(), r.len().div_ceil(LANES));
+            // Grouped by point count, most points first, colour order within a count.
+            let mut expected: Vec<usize> = r.clone().collect();
+            expected.sort_by_key(|&k| std::cmp::Reverse(cons[k].len));
+            for (g, w) in wide.cons[wr.clone()].iter().enumerate() {
+                let mut len = 0;
+                for l in 0..LANES {
+                    let c = expected.get(g * LANES + l).map(|&k| &cons[k]);
+                    len = len.max(c.map_or(0, |c| c.len));
+                    assert_lane(w, l, c, &bodies);
+                }
+                assert_eq!(w.len, len);
+            }
+        }
+        assert_eq!(wide.overflow, 0..overflow.len());
+        assert_eq!(overflow_cons.len(), overflow.len());
+        for (c, d) in overflow_cons.iter().zip(&cons[overflow.clone()]) {
+            assert_eq!(c.manifold, d.manifold);
+        }
+    }
+}
+
+/// `store` writes each lane's impulses and friction direction into its manifold exactly as
+/// `contact::store` writes the scalar constraint's.
+#[test]
+fn store_matches_the_scalar_store() {
+    use crate::body_set::BodyHandle;
+    use crate::contact::{ContactManifold, ContactPoint};
+    let mut rng = Rng(99);
+    let (bodies, cons) = scene(&mut rng, 10);
+    let handle = |i: usize| BodyHandle {
+        index: i as u32,
+        generation: 0,
+    };
+    let manifolds: Vec<ContactManifold> = cons
+        .iter()
+        .map(|c| {
+            let mut m = ContactManifold::new(handle(c.a), handle(c.b), c.normal);
+            for k in 0..c.len {
+                m.push(ContactPoint::new(Vec3::ZERO, Vec3::ZERO, 0.0, k as u32))
+                    .unwrap();
+            }
+            m
+        })
+        .collect();
+    let mut wide = WideScratch::default();
+    let mut overflow = Vec::new();
+    let points = |k: usize| cons[k].len;
+    fill(
+        &mut wide,
+        &mut overflow,
+        &[0..10, 10..10],
+        &bodies,
+        points,
+        |k, c| *c = cons[k].clone(),
+    );
+    let (mut m_wide, mut m_scalar) = (manifolds.clone(), manifolds);
+    store(&wide, &mut m_wide, 4.0);
+    contact::store(&cons, &mut m_scalar, 4.0);
+    for (x, y) in m_wide.iter().zip(&m_scalar) {
+        assert_eq!(x.tangent, y.tangent);
+        assert!(x.total_normal_impulse() > 0.0);
+        for (p, q) in x.points().iter().zip(y.points()) {
+            assert_eq!(p.normal_impulse, q.normal_impulse);
+            assert_eq!(p.tangent_impulse, q.tangent_impulse);
+        }
+    }
+}

@@ -28,8 +28,15 @@ mod timing;
 
 pub use timing::StepTimings;
 
-/// The solver's reusable buffers, owned by the world (see [`contact::ContactScratch`]).
-pub(crate) type SolverScratch = contact::ContactScratch;
+/// The solver's reusable buffers, owned by the world and cleared, not freed, from step to
+/// step (see [`contact::ContactScratch`]).
+#[derive(Debug, Clone, Default)]
+pub(crate) struct SolverScratch {
+    /// Contact constraints and their colouring.
+    pub contacts: contact::ContactScratch,
+    /// Per-step constants of the moving bodies' integration.
+    pub terms: Vec<crate::integrate::BodyTerms>,
+}
 
 use crate::body_set::BodySet;
 use crate::contact::ContactManifold;
@@ -167,6 +174,7 @@ pub(crate) struct StepContext<'a> {
 /// deltas since the start of the step (soft step), or the split-impulse pseudo-velocities
 /// (sequential impulses).
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[repr(C)]
 pub(crate) struct SolverBody {
     pub v: Vec3,
     pub w: Vec3,
@@ -179,12 +187,43 @@ pub(crate) struct SolverBody {
 }
 
 impl SolverBody {
+    /// `v, w, dp, dq` as three rows of four scalars (the SIMD gather transposes them):
+    /// `[v.x, v.y, v.z, w.x], [w.y, w.z, dp.x, dp.y], [dp.z, dq.x, dq.y, dq.z]`. `repr(C)`
+    /// keeps the four vectors adjacent at the start of the struct (checked at compile time
+    /// below), so this is three plain vector loads.
+    #[inline(always)]
+    pub fn state(&self) -> [[Real; 4]; 3] {
+        // SAFETY: `SolverBody` is `repr(C)` and starts with the twelve scalars of `v, w, dp,
+        // dq` without padding (checked at compile time below); `[[Real; 4]; 3]` has the same size and
+        // no stricter alignment than `Real`, and every bit pattern is a valid `Real`.
+        unsafe { std::ptr::read_unaligned(self as *const SolverBody as *const [[Real; 4]; 3]) }
+    }
+
+    /// Sets `v` and `w` from the first rows of [`SolverBody::state`] (the last two scalars
+    /// of the second row are ignored).
+    #[inline(always)]
+    pub fn set_velocities(&mut self, r0: [Real; 4], r1: [Real; 4]) {
+        self.v = Vec3::new(r0[0], r0[1], r0[2]);
+        self.w = Vec3::new(r0[3], r1[0], r1[1]);
+    }
+
     /// Velocity of the material point at lever arm `r`.
     #[inline]
     pub fn point_velocity(&self, r: Vec3) -> Vec3 {
         self.v + self.w.cross(r)
     }
 }
+
+// [`SolverBody::state`] reads `v, w, dp, dq` as twelve consecutive scalars from the start.
+const _: () = {
+    use std::mem::{offset_of, size_of};
+    let r = size_of::<Real>();
+    assert!(size_of::<Vec3>() == 3 * r);
+    assert!(offset_of!(SolverBody, v) == 0);
+    assert!(offset_of!(SolverBody, w) == 3 * r);
+    assert!(offset_of!(SolverBody, dp) == 6 * r);
+    assert!(offset_of!(SolverBody, dq) == 9 * r);
+};
 
 /// Soft-constraint coefficients (Box2D v3's `b2Softness`, from Catto's "Solver2D"): a spring
 /// of frequency `hertz` and damping ratio `zeta` integrated implicitly over a step `h`.

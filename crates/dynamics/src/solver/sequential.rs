@@ -18,11 +18,13 @@ pub(crate) fn step(ctx: &mut StepContext) {
     let p = *ctx.params;
     let dt = ctx.dt;
     let mut t = Instant::now();
-    integrate::integrate_velocities(ctx.set, ctx.bodies, ctx.gravity, dt, ctx.gyroscopic);
+    let terms = &mut ctx.scratch.terms;
+    integrate::prepare_terms(ctx.set, ctx.bodies, ctx.gravity, dt, ctx.gyroscopic, terms);
+    integrate::integrate_velocities(&mut terms[..], &ctx.set.rotation, ctx.bodies, dt);
     lap(&mut t, &mut ctx.timings.forces);
 
     let warm = if p.warm_starting { 1.0 } else { 0.0 };
-    let scratch = &mut *ctx.scratch;
+    let scratch = &mut ctx.scratch.contacts;
     contact::prepare(
         ctx.manifolds,
         ctx.set,
@@ -30,6 +32,7 @@ pub(crate) fn step(ctx: &mut StepContext) {
         warm,
         Softness::RIGID,
         Softness::RIGID,
+        false,
         scratch,
     );
     let (cons, ranges) = (&mut scratch.cons, &scratch.colouring.ranges[..]);

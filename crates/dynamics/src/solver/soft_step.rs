@@ -37,7 +37,10 @@ pub(crate) fn step(ctx: &mut StepContext) {
         0.0
     };
     let (soft, static_soft) = contact::softness_pair(&p, h);
-    let scratch = &mut *ctx.scratch;
+    let scratch = &mut ctx.scratch.contacts;
+    let terms = &mut ctx.scratch.terms;
+    integrate::prepare_terms(ctx.set, ctx.bodies, ctx.gravity, h, ctx.gyroscopic, terms);
+    let simd = p.simd;
     contact::prepare(
         ctx.manifolds,
         ctx.set,
@@ -45,17 +48,9 @@ pub(crate) fn step(ctx: &mut StepContext) {
         warm,
         soft,
         static_soft,
+        simd,
         scratch,
     );
-    let simd = p.simd;
-    if simd {
-        contact_simd::build(
-            &scratch.cons,
-            &scratch.colouring.ranges,
-            ctx.bodies,
-            &mut scratch.wide,
-        );
-    }
     let (cons, ranges, wide) = (
         &mut scratch.cons,
         &scratch.colouring.ranges[..],
@@ -69,7 +64,7 @@ pub(crate) fn step(ctx: &mut StepContext) {
     lap(&mut t, &mut ctx.timings.prepare);
 
     for _ in 0..n {
-        integrate::integrate_velocities(ctx.set, ctx.bodies, ctx.gravity, h, ctx.gyroscopic);
+        integrate::integrate_velocities(&mut terms[..], &ctx.set.rotation, ctx.bodies, h);
         lap(&mut t, &mut ctx.timings.forces);
 
         if p.warm_starting {
@@ -87,10 +82,10 @@ pub(crate) fn step(ctx: &mut StepContext) {
         joints::solve(rows, ctx.bodies, joint_soft, inv_h, true);
         let solve = (inv_h, max_push, true);
         solve_contacts(simd, wide, cons, ranges, ctx.bodies, (par, min), solve);
-        integrate::clamp_speeds(ctx.set, ctx.bodies);
         lap(&mut t, &mut ctx.timings.solve);
 
-        integrate::integrate_positions(ctx.set, ctx.bodies, h, false);
+        // The speed clamp of the solve and the position update, fused in one pass.
+        integrate::clamp_and_integrate_positions(terms, ctx.set, ctx.bodies, h);
         lap(&mut t, &mut ctx.timings.integrate);
 
         // Joint rows follow the new poses (they stay valid until the next position update).
@@ -103,16 +98,16 @@ pub(crate) fn step(ctx: &mut StepContext) {
 
     let threshold = p.restitution_threshold;
     if simd {
-        contact_simd::solve(
+        contact_simd::solve_active(
             wide,
             cons,
             ctx.bodies,
-            par,
-            min,
+            (par, min),
+            contact_simd::has_restitution,
             |c, a, b| contact_simd::apply_restitution(c, a, b, threshold),
             |c, a, b| contact::apply_restitution(c, a, b, threshold),
         );
-        contact_simd::write_back(wide, cons);
+        contact_simd::store(wide, ctx.manifolds, n as Real);
     } else {
         solve_coloured(cons, ranges, ctx.bodies, par, min, |c, a, b| {
             contact::apply_restitution(c, a, b, threshold)

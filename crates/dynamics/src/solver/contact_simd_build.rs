@@ -1,0 +1,298 @@
+//! Building the four-wide contact constraints and storing their impulses (module
+//! `contact_simd`).
+//!
+//! The constraints of every colour but the overflow one are written straight into their
+//! lanes as they are prepared ([`fill`]): no scalar constraint array is built for them and
+//! transposed afterwards, and the wide constraints of the last step are overwritten in
+//! place (every field of every lane that the solve reads, padding included), so a step
+//! neither zeroes nor copies the (large) constraint arrays. Box2D v3 prepares its SIMD constraints the same way
+//! (`b2PrepareContactsTask` writes `b2ContactConstraintSIMD` lanes directly).
+
+use super::{WideConstraint, WidePoint, WideRow, WideScratch, LANES, NONE, V3, W};
+use crate::contact::{ContactManifold, MAX_MANIFOLD_POINTS};
+use crate::solver::contact::{ContactConstraint, ContactRow};
+use crate::solver::SolverBody;
+use carom_collision::math::{Real, Vec3};
+use std::ops::Range;
+
+/// Sets lane `l` of `w` to `x`.
+#[inline(always)]
+fn put(w: &mut W, l: usize, x: Real) {
+    w.as_mut_array()[l] = x;
+}
+
+/// Sets lane `l` of `v` to `x`.
+#[inline(always)]
+fn put3(v: &mut V3, l: usize, x: Vec3) {
+    put(&mut v.x, l, x.x);
+    put(&mut v.y, l, x.y);
+    put(&mut v.z, l, x.z);
+}
+
+/// Lane `l` of `v`.
+#[inline(always)]
+fn get3(v: &V3, l: usize) -> Vec3 {
+    Vec3::new(v.x.as_array()[l], v.y.as_array()[l], v.z.as_array()[l])
+}
+
+impl WideRow {
+    /// Lane `l` becomes `r` (a zero row leaves its impulse at zero).
+    #[inline(always)]
+    fn set_lane(&mut self, l: usize, r: &ContactRow) {
+        put3(&mut self.ang_a, l, r.ang_a);
+        put3(&mut self.ang_b, l, r.ang_b);
+        put3(&mut self.inv_ang_a, l, r.inv_ang_a);
+        put3(&mut self.inv_ang_b, l, r.inv_ang_b);
+        put(&mut self.mass, l, r.mass);
+    }
+}
+
+impl WidePoint {
+    /// Lane `l` becomes point `k` of `c`, or an empty point when `c` has fewer points.
+    #[inline(always)]
+    fn set_lane(&mut self, l: usize, c: &ContactConstraint, k: usize) {
+        let p = (k < c.len).then(|| &c.points[k]);
+        let zero = &ContactRow::ZERO;
+        self.normal_row
+            .set_lane(l, p.map_or(zero, |p| &p.normal_row));
+        for (j, row) in self.tangent_rows.iter_mut().enumerate() {
+            row.set_lane(l, p.map_or(zero, |p| &p.tangent_rows[j]));
+        }
+        let val = |f: fn(&super::super::contact::PointConstraint) -> Real| p.map_or(0.0, f);
+        put(&mut self.separation, l, val(|p| p.separation));
+        put(&mut self.relative_velocity, l, val(|p| p.relative_velocity));
+        put(&mut self.normal_impulse, l, val(|p| p.normal_impulse));
+        put(
+            &mut self.tangent_impulse[0],
+            l,
+            val(|p| p.tangent_impulse[0]),
+        );
+        put(
+            &mut self.tangent_impulse[1],
+            l,
+            val(|p| p.tangent_impulse[1]),
+        );
+        put(
+            &mut self.max_normal_impulse,
+            l,
+            val(|p| p.max_normal_impulse),
+        );
+    }
+}
+
+impl WideConstraint {
+    /// A constraint with four padding lanes.
+    pub(super) fn empty() -> Self {
+        WideConstraint {
+            a: [NONE; LANES],
+            b: [NONE; LANES],
+            write_a: [false; LANES],
+            write_b: [false; LANES],
+            manifold: [NONE; LANES],
+            lens: [0; LANES],
+            inv_m_a: W::default(),
+            inv_m_b: W::default(),
+            normal: V3::default(),
+            tangent: [V3::default(); 2],
+            friction: W::default(),
+            restitution: W::default(),
+            bias_rate: W::default(),
+            mass_scale: W::default(),
+            impulse_scale: W::default(),
+            points: [WidePoint::default(); MAX_MANIFOLD_POINTS],
+            len: 0,
+        }
+    }
+
+    /// Lane `l` becomes constraint `c` (whose bodies are `bodies[c.a]`, `bodies[c.b]`), or a
+    /// padding lane (zero rows, no bodies) for `None`. Every field of the lane is written but
+    /// the points from `c.len` on: [`WideConstraint::pad_points`] zeroes those the solve
+    /// reads once the group is complete.
+    fn set_lane(&mut self, l: usize, c: Option<&ContactConstraint>, bodies: &[SolverBody]) {
+        let c = c.unwrap_or(&ContactConstraint::EMPTY);
+        let pad = c.len == 0;
+        let (a, b) = if pad { (NONE, NONE) } else { (c.a, c.b) };
+        self.a[l] = a;
+        self.b[l] = b;
+        self.write_a[l] = !pad && bodies[a].dynamic;
+        self.write_b[l] = !pad && bodies[b].dynamic;
+        self.manifold[l] = if pad { NONE } else { c.manifold };
+        self.lens[l] = c.len;
+        put(
+            &mut self.inv_m_a,
+            l,
+            if pad { 0.0 } else { bodies[a].inv_m },
+        );
+        put(
+            &mut self.inv_m_b,
+            l,
+            if pad { 0.0 } else { bodies[b].inv_m },
+        );
+        put3(&mut self.normal, l, c.normal);
+        put3(&mut self.tangent[0], l, c.tangent[0]);
+        put3(&mut self.tangent[1], l, c.tangent[1]);
+        put(&mut self.friction, l, c.friction);
+        put(&mut self.restitution, l, c.restitution);
+        put(&mut self.bias_rate, l, c.softness.bias_rate);
+        put(&mut self.mass_scale, l, c.softness.mass_scale);
+        put(&mut self.impulse_scale, l, c.softness.impulse_scale);
+        for (k, wp) in self.points[..c.len].iter_mut().enumerate() {
+            wp.set_lane(l, c, k);
+        }
+    }
+
+    /// Zeroes the points `lens[l]..len` of every lane `l`, which the solve reads (it runs
+    /// `len` points in every lane). Points from `len` on are never read and keep whatever
+    /// they held: with the constraints of a colour grouped by point count, most groups have
+    /// lanes of equal length, and a group of one-point lanes writes one point instead of four.
+    fn pad_points(&mut self) {
+        for l in 0..LANES {
+            for k in self.lens[l]..self.len {
+                self.points[k].set_lane(l, &ContactConstraint::EMPTY, k);
+            }
+        }
+    }
+}
+
+/// Builds the constraints of a step: `make(k, out)` prepares the constraint at position `k` of
+/// the colour order, which will have `points(k)` points; `ranges` are the colour ranges of
+/// that order, the last being the overflow colour. The constraints of each colour but the
+/// last go four at a time into the lanes of `out.cons` (reusing last step's wide
+/// constraints); the overflow colour's go to `cons` (cleared first), and `out.overflow` is
+/// their range there. Allocates only when a buffer must grow.
+///
+/// Inside a colour the constraints are grouped by point count (four-point ones first, in
+/// colour order within a count): a wide constraint solves as many points as its fullest
+/// lane, so mixing a one-point lane with a four-point lane wastes three points of work. The
+/// constraints of a colour share no dynamic body, so their order inside the colour does not
+/// change any result (and depends only on the colour order, not on the thread count).
+pub(crate) fn fill(
+    out: &mut WideScratch,
+    cons: &mut Vec<ContactConstraint>,
+    ranges: &[Range<usize>],
+    bodies: &[SolverBody],
+    points: impl Fn(usize) -> usize,
+    mut make: impl FnMut(usize, &mut ContactConstraint),
+) {
+    cons.clear();
+    out.ranges.clear();
+    let Some((overflow, colours)) = ranges.split_last() else {
+        out.cons.clear();
+        out.overflow = 0..0;
+        return;
+    };
+    let bucket = |k: usize| points(k).clamp(1, MAX_MANIFOLD_POINTS);
+    // One constraint at a time is prepared here and written into its lane.
+    let mut c = ContactConstraint::EMPTY;
+    let mut used = 0;
+    for r in colours {
+        let start = used;
+        // Lane of the next constraint in the current wide constraint `used - 1`.
+        let mut lane = LANES;
+        for count in (1..=MAX_MANIFOLD_POINTS).rev() {
+            for k in r.clone().filter(|&k| bucket(k) == count) {
+                if lane == LANES {
+                    if used == out.cons.len() {
+                        out.cons.push(WideConstraint::empty());
+                    }
+                    out.cons[used].len = 0;
+                    used += 1;
+                    lane = 0;
+                }
+                let w = &mut out.cons[used - 1];
+                make(k, &mut c);
+                w.len = w.len.max(c.len);
+                w.set_lane(lane, Some(&c), bodies);
+                lane += 1;
+            }
+        }
+        if used > start {
+            for l in lane..LANES {
+                out.cons[used - 1].set_lane(l, None, bodies);
+            }
+        }
+        out.ranges.push(start..used);
+    }
+    out.cons.truncate(used);
+    for w in &mut out.cons {
+        w.pad_points();
+    }
+    cons.extend(overflow.clone().map(|k| {
+        let mut c = ContactConstraint::EMPTY;
+        make(k, &mut c);
+        c
+    }));
+    out.overflow = 0..cons.len();
+}
+
+/// Groups already prepared scalar constraints (`cons`, in colour order with colour `ranges`,
+/// the last being the overflow colour) into `out`, as [`fill`] does while preparing; the
+/// overflow colour stays in `cons` (`out.overflow` is its range). For the tests, which
+/// compare the wide routines with the scalar ones on the same constraints.
+#[cfg(test)]
+pub(crate) fn build(
+    cons: &[ContactConstraint],
+    ranges: &[Range<usize>],
+    bodies: &[SolverBody],
+    out: &mut WideScratch,
+) {
+    let mut scratch = Vec::new();
+    let points = |k: usize| cons[k].len;
+    let Some((overflow, colours)) = ranges.split_last() else {
+        fill(out, &mut scratch, ranges, bodies, points, |k, c| {
+            *c = cons[k].clone()
+        });
+        return;
+    };
+    // The overflow colour is left out of the lanes and kept in `cons` by range.
+    let mut rs: Vec<Range<usize>> = colours.to_vec();
+    rs.push(overflow.start..overflow.start);
+    fill(out, &mut scratch, &rs, bodies, points, |k, c| {
+        *c = cons[k].clone()
+    });
+    out.overflow = overflow.clone();
+}
+
+/// Writes the accumulated impulses (scaled to per-step units) and the friction direction of
+/// every lane into its manifold, as `contact::store` does for scalar constraints.
+pub(crate) fn store(wide: &WideScratch, manifolds: &mut [ContactManifold], scale: Real) {
+    for w in &wide.cons {
+        for l in 0..LANES {
+            let m_index = w.manifold[l];
+            if m_index == NONE {
+                continue;
+            }
+            let m = &mut manifolds[m_index];
+            m.tangent = get3(&w.tangent[0], l);
+            for (out, wp) in m.points_mut().iter_mut().zip(&w.points[..w.lens[l]]) {
+                out.normal_impulse = wp.normal_impulse.as_array()[l] * scale;
+                out.tangent_impulse = [
+                    wp.tangent_impulse[0].as_array()[l] * scale,
+                    wp.tangent_impulse[1].as_array()[l] * scale,
+                ];
+            }
+        }
+    }
+}
+
+/// Copies the impulses of every lane back into the scalar constraint it was built from
+/// (`cons[manifold]` in the tests, where constraint `k` is manifold `k`).
+#[cfg(test)]
+pub(crate) fn write_back(wide: &WideScratch, cons: &mut [ContactConstraint]) {
+    for w in &wide.cons {
+        for l in 0..LANES {
+            let Some(c) = cons.iter_mut().find(|c| c.manifold == w.manifold[l]) else {
+                continue;
+            };
+            for (k, p) in c.points[..c.len].iter_mut().enumerate() {
+                let wp = &w.points[k];
+                p.normal_impulse = wp.normal_impulse.as_array()[l];
+                p.tangent_impulse = [
+                    wp.tangent_impulse[0].as_array()[l],
+                    wp.tangent_impulse[1].as_array()[l],
+                ];
+                p.max_normal_impulse = wp.max_normal_impulse.as_array()[l];
+            }
+        }
+    }
+}
