@@ -51,8 +51,9 @@ pub struct Polyhedron<'a> {
     loops: &'a [u32],
     edges: &'a [[u32; 2]],
     edge_faces: &'a [[u32; 2]],
-    /// True for a flat polygon (a triangle): its edges' Gauss arcs are half circles and
-    /// are never pruned.
+    /// True for a flat polygon (a triangle): its edges' Gauss-map arcs are half circles
+    /// through their outward in-plane normals (see `polyhedron_sat`), pruned as such; only
+    /// a view of a real flat polygon may set it.
     pub flat: bool,
 }
 
