@@ -99,6 +99,7 @@ pub enum GjkEpa {
 
 /// GJK on cores plus radii, EPA when the cores overlap, unchecked (see [`GjkEpa`];
 /// [`contact_gjk_epa`] adds the guard).
+#[inline]
 pub fn contact_gjk_epa_unguarded(
     a: ConvexRef<'_>,
     b: ConvexRef<'_>,
