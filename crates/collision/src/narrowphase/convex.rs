@@ -12,6 +12,10 @@ use crate::math::{consts::PI, orthonormal_basis, Isometry, Quat, Real, Vec3};
 use crate::query::closest_points::closest_point_segment;
 use crate::query::{contact_convex, Contact};
 use crate::shape::{Capsule, ConvexRef};
+use smallvec::{smallvec, SmallVec};
+
+/// The contacts of a capsule pair or a capsule on a polyhedron: at most two, on the stack.
+pub type TwoContacts = SmallVec<[(Contact, FeatureId); 2]>;
 
 /// Bullet's perturbation angle limit (radians).
 pub const MAX_PERTURBATION_ANGLE: Real = 0.125;
@@ -68,14 +72,14 @@ pub fn capsule_capsule_manifold(
     b: &Capsule,
     pose_ab: &Isometry,
     prediction: Real,
-) -> Vec<(Contact, FeatureId)> {
+) -> TwoContacts {
     let Some(c0) = contact_convex(
         ConvexRef::Capsule(a),
         ConvexRef::Capsule(b),
         pose_ab,
         prediction,
     ) else {
-        return Vec::new();
+        return TwoContacts::new();
     };
     let (pa, qa) = capsule_segment(a, &Isometry::IDENTITY);
     let (pb, qb) = capsule_segment(b, pose_ab);
@@ -88,7 +92,7 @@ pub fn capsule_capsule_manifold(
         };
         if t1 - t0 > 1.0e-4 * (1.0 + len) {
             let (ra, rb) = (a.radius(), b.radius());
-            let out: Vec<(Contact, FeatureId)> = [t0, t1]
+            let out: TwoContacts = [t0, t1]
                 .iter()
                 .enumerate()
                 .filter_map(|(k, &t)| {
@@ -119,7 +123,7 @@ pub fn capsule_capsule_manifold(
             }
         }
     }
-    vec![(c0, 2)]
+    smallvec![(c0, 2)]
 }
 
 /// Capsule A against polyhedron B (`poly` is B's polyhedron view, `b` its convex shape):
@@ -131,9 +135,9 @@ pub fn capsule_polyhedron_manifold(
     poly: &Polyhedron,
     pose_ab: &Isometry,
     prediction: Real,
-) -> Vec<(Contact, FeatureId)> {
+) -> TwoContacts {
     let Some(c0) = contact_convex(ConvexRef::Capsule(a), b, pose_ab, prediction) else {
-        return Vec::new();
+        return TwoContacts::new();
     };
     let nb = pose_ab.inverse_transform_vector(c0.normal);
     let mut face = None;
@@ -146,7 +150,7 @@ pub fn capsule_polyhedron_manifold(
         }
     }
     let Some(fi) = face else {
-        return vec![(c0, 2)];
+        return smallvec![(c0, 2)];
     };
     let pose_ba = pose_ab.inverse();
     let (p, q) = capsule_segment(a, &pose_ba);
@@ -159,7 +163,7 @@ pub fn capsule_polyhedron_manifold(
         let side = (v1 - v0).cross(fnorm).normalize_or_zero();
         let (dp, dq) = (side.dot(p - v0), side.dot(q - v0));
         if dp > 0.0 && dq > 0.0 {
-            return vec![(c0, 2)];
+            return smallvec![(c0, 2)];
         }
         if (dp > 0.0) != (dq > 0.0) {
             let t = dp / (dp - dq);
@@ -171,10 +175,10 @@ pub fn capsule_polyhedron_manifold(
         }
     }
     if t1 - t0 < 1.0e-4 {
-        return vec![(c0, 2)];
+        return smallvec![(c0, 2)];
     }
     let r = a.radius();
-    let mut out = Vec::new();
+    let mut out = TwoContacts::new();
     for (k, t) in [t0, t1].into_iter().enumerate() {
         let e = p + (q - p) * t;
         let h = fnorm.dot(e) - off;

@@ -10,7 +10,7 @@ use super::convex::{
     plane_capsule_manifold,
 };
 use super::manifold::{ContactManifold, ManifoldConfig};
-use super::mesh::{mesh_convex_contacts, mix_feature, ContactTriangles};
+use super::mesh::{mesh_convex_contacts, mesh_hull_contacts, mix_feature, ContactTriangles};
 use super::polyhedron::{
     plane_polyhedron_manifold, polyhedron_manifold_guided, polyhedron_manifold_into, Polyhedron,
     SAT_MAX_EDGE_PAIRS,
@@ -280,6 +280,10 @@ fn triangles_convex_into<M: ContactTriangles>(
     let incremental =
         as_polyhedron(cb).is_none() && !matches!(cb, ConvexRef::Sphere(_) | ConvexRef::Capsule(_));
     let full = want_full && incremental;
+    if let ConvexRef::ConvexHull(h) = cb {
+        mesh_hull_contacts(m, h, pose_ab, cfg.prediction, out);
+        return true;
+    }
     let mut tri_contacts = |t: &Triangle, out: &mut ContactList| {
         convex_convex_into(ConvexRef::Triangle(t), cb, pose_ab, cfg, full, out);
     };

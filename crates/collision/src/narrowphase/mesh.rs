@@ -11,11 +11,14 @@
 //! it may turn up to the dihedral angle.
 
 use super::contact::{ContactList, FeatureId};
+use super::polyhedron::{polyhedron_manifold_posed, Polyhedron, PosedPolyhedron};
 use crate::math::Aabb;
 use crate::math::{Isometry, Real, Vec3};
 use crate::query::closest_points::closest_point_segment;
 use crate::query::Contact;
-use crate::shape::{ConvexRef, EdgeKind, HeightField, MeshEdge, SupportMap, TriMesh, Triangle};
+use crate::shape::{
+    ConvexHull, ConvexRef, EdgeKind, HeightField, MeshEdge, SupportMap, TriMesh, Triangle,
+};
 use smallvec::SmallVec;
 
 /// A triangle soup with a midphase and precomputed (or derivable) edge convexity: what
@@ -191,4 +194,26 @@ pub fn mesh_convex_contacts<M: ContactTriangles + ?Sized>(
         }
         out.truncate(keep);
     }
+}
+
+/// Triangles A against convex hull B: [`mesh_convex_contacts`] with the triangle–hull
+/// separating-axis test of [`super::polyhedron`], the hull placed in the mesh's frame once
+/// (vertices, face planes, edge arcs) for all the triangles instead of once per triangle.
+/// The contacts are those of the per-triangle `convex_convex` path, bit for bit.
+pub fn mesh_hull_contacts<M: ContactTriangles + ?Sized>(
+    mesh: &M,
+    hull: &ConvexHull,
+    pose_ab: &Isometry,
+    prediction: Real,
+    out: &mut ContactList,
+) {
+    let pb = Polyhedron::from_hull(hull);
+    let mut posed: Option<PosedPolyhedron> = None;
+    let mut tri_contacts = |t: &Triangle, out: &mut ContactList| {
+        let posed = posed.get_or_insert_with(|| PosedPolyhedron::new(&pb, pose_ab, true));
+        let pa = Polyhedron::from_triangle(t);
+        polyhedron_manifold_posed(&pa, &pb, posed, pose_ab, prediction, out);
+    };
+    let b = ConvexRef::ConvexHull(hull);
+    mesh_convex_contacts(mesh, b, pose_ab, prediction, &mut tri_contacts, out);
 }

@@ -21,6 +21,7 @@ pub mod dispatcher;
 pub mod mesh;
 pub mod polyhedron;
 pub mod polyhedron_guided;
+mod polyhedron_sat;
 pub mod triangle_cuboid;
 
 pub use dispatcher::{Dispatcher, Generated, UserAlgorithm};

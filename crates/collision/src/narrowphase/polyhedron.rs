@@ -9,6 +9,8 @@ use super::contact::FeatureId;
 pub use super::polyhedron_guided::{
     polyhedron_contact, polyhedron_manifold_guided, EPA_FEATURE, SAT_MAX_EDGE_PAIRS,
 };
+pub(crate) use super::polyhedron_sat::PosedPolyhedron;
+use super::polyhedron_sat::{edge_query, face_query};
 use crate::math::{Isometry, Real, Vec3};
 use crate::query::closest_points::closest_points_segment_segment;
 use crate::query::Contact;
@@ -16,9 +18,6 @@ use crate::shape::convex_hull::edge_face_pairs;
 use crate::shape::{ConvexHull, Cuboid, HullFace, Triangle};
 use smallvec::SmallVec;
 use std::sync::OnceLock;
-
-/// Scratch arrays of transformed vertices or normals: on the stack up to 64 entries.
-type Buf = SmallVec<[Vec3; 64]>;
 
 /// Borrowed (hulls) or inline (boxes, triangles) storage, so that building a view never
 /// allocates.
@@ -52,8 +51,9 @@ pub struct Polyhedron<'a> {
     loops: &'a [u32],
     edges: &'a [[u32; 2]],
     edge_faces: &'a [[u32; 2]],
-    /// True for a flat polygon (a triangle): its edges' Gauss arcs are half circles and
-    /// are never pruned.
+    /// True for a flat polygon (a triangle): its edges' Gauss-map arcs are half circles
+    /// through their outward in-plane normals (see `polyhedron_sat`), pruned as such; only
+    /// a view of a real flat polygon may set it.
     pub flat: bool,
 }
 
@@ -111,6 +111,12 @@ impl<'a> Polyhedron<'a> {
     #[inline]
     pub fn edges(&self) -> &[[u32; 2]] {
         self.edges
+    }
+
+    /// For each edge, its two adjacent faces.
+    #[inline]
+    pub fn edge_faces(&self) -> &[[u32; 2]] {
+        self.edge_faces
     }
 
     /// The loop of face `f`.
@@ -189,117 +195,6 @@ impl<'a> Polyhedron<'a> {
             flat: true,
         }
     }
-}
-
-#[inline]
-fn max_dot(points: &[Vec3], dir: Vec3) -> Real {
-    points
-        .iter()
-        .map(|v| v.dot(dir))
-        .fold(Real::NEG_INFINITY, Real::max)
-}
-
-/// Face query: the face (given by normals and offsets in A's frame) with the greatest
-/// separation from the points `others` (the other shape's vertices in the same frame).
-fn face_query(normals: &[Vec3], offsets: &[Real], others: &[Vec3]) -> (Real, usize) {
-    let mut best = (Real::NEG_INFINITY, 0);
-    for (i, (&n, &off)) in normals.iter().zip(offsets).enumerate() {
-        let s = -max_dot(others, -n) - off;
-        if s > best.0 {
-            best = (s, i);
-        }
-    }
-    best
-}
-
-/// Gregorius' Minkowski-face test: arcs AB and CD of the Gauss map intersect.
-#[inline]
-fn is_minkowski_face(a: Vec3, b: Vec3, c: Vec3, d: Vec3) -> bool {
-    let bxa = b.cross(a);
-    let dxc = d.cross(c);
-    let cba = c.dot(bxa);
-    let dba = d.dot(bxa);
-    let adc = a.dot(dxc);
-    let bdc = b.dot(dxc);
-    cba * dba < 0.0 && adc * bdc < 0.0 && cba * bdc > 0.0
-}
-
-/// Edge query: the edge pair with the greatest separation among the pairs that build a
-/// face of the Minkowski difference. `vb` and `nb` are B's vertices and face normals in A's
-/// frame.
-fn edge_query(
-    a: &Polyhedron,
-    b: &Polyhedron,
-    vb: &[Vec3],
-    nb: &[Vec3],
-) -> (Real, usize, usize, Vec3) {
-    let mut best = (Real::NEG_INFINITY, 0, 0, Vec3::ZERO);
-    let va = a.vertices();
-    let a_centre = va.iter().fold(Vec3::ZERO, |s, v| s + *v) / va.len().max(1) as Real;
-    let flat = a.flat || b.flat;
-    for (i, (ea, fa)) in a.edges.iter().zip(a.edge_faces).enumerate() {
-        let (pa, qa) = (va[ea[0] as usize], va[ea[1] as usize]);
-        let (na0, na1) = (
-            a.faces[fa[0] as usize].normal,
-            a.faces[fa[1] as usize].normal,
-        );
-        let da = qa - pa;
-        for (j, (eb, fb)) in b.edges.iter().zip(b.edge_faces).enumerate() {
-            if !flat && !is_minkowski_face(na0, na1, -nb[fb[0] as usize], -nb[fb[1] as usize]) {
-                continue;
-            }
-            let (pb, qb) = (vb[eb[0] as usize], vb[eb[1] as usize]);
-            let db = qb - pb;
-            let axis = da.cross(db);
-            let len = axis.length();
-            // Parallel edges: no Minkowski face, the face axes decide.
-            if len < PARALLEL_SIN * da.length() * db.length() || len == 0.0 {
-                continue;
-            }
-            let axis = axis / len;
-            let (s, ax) = if flat {
-                // Flat polygons: exact separation along ±axis, keeping only the orientations
-                // along which both edges are supporting features (a flat polygon's Gauss map
-                // condition; otherwise the witness points below would not lie on the shapes).
-                let (max_a, min_a) = (max_dot(va, axis), -max_dot(va, -axis));
-                let (max_b, min_b) = (max_dot(vb, axis), -max_dot(vb, -axis));
-                let eps = 1.0e-4 * (max_a - min_a + max_b - min_b);
-                let (ea, eb) = (pa.dot(axis), pb.dot(axis));
-                let s1 = (ea >= max_a - eps && eb <= min_b + eps).then_some(min_b - max_a);
-                let s2 = (ea <= min_a + eps && eb >= max_b - eps).then_some(min_a - max_b);
-                match (s1, s2) {
-                    (Some(s1), Some(s2)) if s2 > s1 => (s2, -axis),
-                    (Some(s1), _) => (s1, axis),
-                    (None, Some(s2)) => (s2, -axis),
-                    (None, None) => continue,
-                }
-            } else {
-                // Gregorius: orient the axis away from A's centre; the edges are the
-                // supporting features of a Minkowski face, so the distance is along them.
-                let ax = if axis.dot(pa - a_centre) < 0.0 {
-                    -axis
-                } else {
-                    axis
-                };
-                (ax.dot(pb - pa), ax)
-            };
-            if s > best.0 {
-                // Gregorius' edge distance holds only for a true Minkowski face; near the
-                // Gauss-map test's round-off it can overstate the separation (the polytope
-                // oracle caught depths 15 % short). A new best is checked by projecting both
-                // shapes, which is exact for any axis.
-                let exact = if flat {
-                    s
-                } else {
-                    -max_dot(vb, -ax) - max_dot(va, ax)
-                };
-                if exact > best.0 {
-                    best = (exact, i, j, ax);
-                }
-            }
-        }
-    }
-    best
 }
 
 /// Relative preference for faces in the separating-axis test: an edge pair (or the other
@@ -457,37 +352,32 @@ pub fn polyhedron_manifold_into(
     prediction: Real,
     out: &mut Vec<(Contact, FeatureId)>,
 ) {
-    // B's vertices and face planes in A's frame, once.
-    let vb: Buf = b
-        .vertices()
-        .iter()
-        .map(|v| pose_ab.transform_point(*v))
-        .collect();
-    let (sa, fa) = {
-        let na: Buf = a.faces.iter().map(|f| f.normal).collect();
-        let oa: SmallVec<[Real; 64]> = a.faces.iter().map(|f| f.offset).collect();
-        face_query(&na, &oa, &vb)
-    };
+    let posed = PosedPolyhedron::new(b, pose_ab, a.flat || b.flat);
+    polyhedron_manifold_posed(a, b, &posed, pose_ab, prediction, out);
+}
+
+/// [`polyhedron_manifold_into`] with B already placed in A's frame (`posed`, built from `b`
+/// and `pose_ab` with edge arcs when either shape is flat): a convex against many triangles
+/// of a mesh places it once and runs this per triangle.
+pub(crate) fn polyhedron_manifold_posed(
+    a: &Polyhedron,
+    b: &Polyhedron,
+    posed: &PosedPolyhedron,
+    pose_ab: &Isometry,
+    prediction: Real,
+    out: &mut Vec<(Contact, FeatureId)>,
+) {
+    let (vb, nb, ob) = (&posed.vertices[..], &posed.normals[..], &posed.offsets[..]);
+    let (sa, fa) = face_query(a.faces.iter().map(|f| (f.normal, f.offset)), vb);
     if sa > prediction {
         return;
     }
-    let nb: Buf = b
-        .faces
-        .iter()
-        .map(|f| pose_ab.transform_vector(f.normal))
-        .collect();
-    let ob: SmallVec<[Real; 64]> = b
-        .faces
-        .iter()
-        .zip(&nb)
-        .map(|(f, n)| f.offset + n.dot(pose_ab.translation))
-        .collect();
-    let (sb, fb) = face_query(&nb, &ob, a.vertices());
+    let (sb, fb) = face_query(nb.iter().copied().zip(ob.iter().copied()), a.vertices());
     if sb > prediction {
         return;
     }
     let start = out.len();
-    let (se, ia, ib, axis) = edge_query(a, b, &vb, &nb);
+    let (se, ia, ib, axis) = edge_query(a, b, posed);
     if se > prediction {
         return;
     }
@@ -527,10 +417,7 @@ pub fn polyhedron_manifold_into(
         // The incident face does not hold the deepest vertex (deep or lateral contact):
         // add the deepest vertex along the SAT's face axis, so the manifold's depth is the
         // minimum penetration.
-        out.push((
-            sat_point(a, (&vb, &nb, &ob), (sa, fa), fb, best),
-            EPA_FEATURE,
-        ));
+        out.push((sat_point(a, (vb, nb, ob), (sa, fa), fb, best), EPA_FEATURE));
     }
     if out.len() == start {
         // The clipped face lies beyond the prediction or beside the reference face while
@@ -543,7 +430,7 @@ pub fn polyhedron_manifold_into(
                 out.push((c, EPA_FEATURE));
             }
             _ if best <= prediction && (sa >= best || sb >= best) => {
-                let c = sat_point(a, (&vb, &nb, &ob), (sa, fa), fb, best);
+                let c = sat_point(a, (vb, nb, ob), (sa, fa), fb, best);
                 out.push((c, EPA_FEATURE));
             }
             _ => {}

@@ -4,6 +4,7 @@
 use super::contact::FeatureId;
 use super::polyhedron::{clip_faces, polyhedron_manifold_into, Polyhedron};
 use crate::math::{Isometry, Real, Vec3};
+use crate::query::contact_convex::{contact_gjk_epa_unguarded, GjkEpa};
 use crate::query::contact_cuboid_cuboid::{
     cuboid_cuboid_sat, cuboid_cuboid_witness, Axis, CuboidSat,
 };
@@ -11,7 +12,7 @@ use crate::query::epa::epa;
 use crate::query::gjk::{gjk, GjkResult};
 use crate::query::guard::contact_is_consistent;
 use crate::query::support_adapters::{Support, Transformed};
-use crate::query::{contact_convex, Contact};
+use crate::query::Contact;
 use crate::shape::{ConvexRef, Cuboid};
 use smallvec::SmallVec;
 
@@ -99,12 +100,14 @@ pub fn polyhedron_manifold_guided(
         cuboid_cuboid_manifold_into(x, y, a, b, pose_ab, prediction, out);
         return;
     }
-    let Some(c) = contact_convex(ca, cb, pose_ab, prediction) else {
-        return;
+    // GJK/EPA unguarded, then the guard's one check: the shapes' exact separation along the
+    // returned normal must be the returned distance; when it is not (EPA on a degenerate
+    // polytope, e.g. shapes touching within round-off), the full separating-axis test runs
+    // instead (the guard's own fallback for polyhedra, here giving the whole manifold).
+    let c = match contact_gjk_epa_unguarded(ca, cb, pose_ab, prediction) {
+        GjkEpa::Beyond => return,
+        GjkEpa::Separated(c) | GjkEpa::Penetrating(c) => c,
     };
-    // The shared guard of the queries: the shapes' exact separation along the returned
-    // normal must be the returned distance; when it is not (EPA on a degenerate polytope,
-    // e.g. shapes touching within round-off), run the full separating-axis test instead.
     if !contact_is_consistent(ca, cb, pose_ab, &c) {
         polyhedron_manifold_into(a, b, pose_ab, prediction, out);
         return;

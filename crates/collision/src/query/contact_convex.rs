@@ -63,21 +63,56 @@ pub fn contact_convex(
     }
 }
 
-/// The general path: GJK on cores plus radii, EPA when the cores overlap. Works for every
-/// pair of convex shapes; `None` when further apart than `prediction`.
+/// The general path: GJK on cores plus radii, EPA when the cores overlap, each answer checked
+/// by the guard ([`super::guard`]). Works for every pair of convex shapes; `None` when
+/// further apart than `prediction`.
 pub fn contact_gjk_epa(
     a: ConvexRef<'_>,
     b: ConvexRef<'_>,
     pose_ab: &Isometry,
     prediction: Real,
 ) -> Option<Contact> {
+    match contact_gjk_epa_unguarded(a, b, pose_ab, prediction) {
+        GjkEpa::Beyond => None,
+        GjkEpa::Separated(c) => {
+            Some(guarded_separated(a, b, pose_ab, c)).filter(|c| c.distance <= prediction)
+        }
+        // EPA is checked against the support functions and replaced when wrong.
+        GjkEpa::Penetrating(c) => {
+            guarded_contact(a, b, pose_ab, Some(c)).filter(|c| c.distance <= prediction)
+        }
+    }
+}
+
+/// The raw answer of GJK/EPA, before the guard: callers that have a better fallback than
+/// the guard's (the polyhedron narrowphase runs the full separating-axis test) check it
+/// themselves with [`super::guard::contact_is_consistent`].
+#[derive(Debug, Clone, Copy)]
+pub enum GjkEpa {
+    /// Further apart than the prediction distance.
+    Beyond,
+    /// GJK's closest points, within the prediction distance.
+    Separated(Contact),
+    /// EPA's penetration (negative distance).
+    Penetrating(Contact),
+}
+
+/// GJK on cores plus radii, EPA when the cores overlap, unchecked (see [`GjkEpa`];
+/// [`contact_gjk_epa`] adds the guard).
+#[inline]
+pub fn contact_gjk_epa_unguarded(
+    a: ConvexRef<'_>,
+    b: ConvexRef<'_>,
+    pose_ab: &Isometry,
+    prediction: Real,
+) -> GjkEpa {
     let (ra, rb) = (core_radius(a), core_radius(b));
     let radius = ra + rb;
     let core_a = Core(a);
     let core_b = Transformed::new(Core(b), pose_ab);
     let dir = -pose_ab.translation;
     match gjk(&core_a, &core_b, dir, prediction + radius) {
-        GjkResult::BeyondMaxDistance => None,
+        GjkResult::BeyondMaxDistance => GjkEpa::Beyond,
         GjkResult::Separated {
             distance,
             point_a,
@@ -85,52 +120,53 @@ pub fn contact_gjk_epa(
         } => {
             let signed = distance - radius;
             if signed > prediction {
-                return None;
+                return GjkEpa::Beyond;
             }
             let n = (point_b - point_a) / distance;
-            let c = Contact {
+            GjkEpa::Separated(Contact {
                 distance: signed,
                 point_a: point_a + n * ra,
                 point_b: point_b - n * rb,
                 normal: n,
-            };
-            Some(guarded_separated(a, b, pose_ab, c)).filter(|c| c.distance <= prediction)
+            })
         }
         GjkResult::Overlapping(simplex) => {
-            let pen = if radius > 0.0 {
-                epa_polytope(&core_a, &core_b, &simplex).map(|p| (p, ra, rb))
+            let (pen, ra, rb) = if radius > 0.0 {
+                match epa_polytope(&core_a, &core_b, &simplex) {
+                    Some(p) => (p, ra, rb),
+                    None => {
+                        // Full shapes: exact support including the radius.
+                        let full_a = AddRadius {
+                            inner: core_a,
+                            radius: ra,
+                        };
+                        let full_b = Transformed::new(
+                            AddRadius {
+                                inner: Core(b),
+                                radius: rb,
+                            },
+                            pose_ab,
+                        );
+                        let p = match gjk(&full_a, &full_b, dir, Real::INFINITY) {
+                            GjkResult::Overlapping(s) => epa(&full_a, &full_b, &s),
+                            _ => epa(&full_a, &full_b, &simplex),
+                        };
+                        (p, 0.0, 0.0)
+                    }
+                }
             } else {
-                None
+                // No radius: the cores are the shapes, and GJK's simplex is already the one
+                // on the full shapes (a second GJK would repeat the same iterations).
+                (epa(&core_a, &core_b, &simplex), 0.0, 0.0)
             };
-            let (pen, ra, rb) = pen.unwrap_or_else(|| {
-                // Full shapes: exact support including the radius.
-                let full_a = AddRadius {
-                    inner: core_a,
-                    radius: ra,
-                };
-                let full_b = Transformed::new(
-                    AddRadius {
-                        inner: Core(b),
-                        radius: rb,
-                    },
-                    pose_ab,
-                );
-                let p = match gjk(&full_a, &full_b, dir, Real::INFINITY) {
-                    GjkResult::Overlapping(s) => epa(&full_a, &full_b, &s),
-                    _ => epa(&full_a, &full_b, &simplex),
-                };
-                (p, 0.0, 0.0)
-            });
             let depth = pen.depth + ra + rb;
             let n = pen.normal;
-            let raw = Contact {
+            GjkEpa::Penetrating(Contact {
                 distance: -depth,
                 point_a: pen.point_a + n * ra,
                 point_b: pen.point_b - n * rb,
                 normal: n,
-            };
-            // EPA is checked against the support functions and replaced when wrong.
-            guarded_contact(a, b, pose_ab, Some(raw)).filter(|c| c.distance <= prediction)
+            })
         }
     }
 }

@@ -1,5 +1,6 @@
 //! Convex hull shape built from a point cloud.
 
+use super::hull_lanes::{blocks, support_index, Block};
 use super::mass::polyhedron_mass_properties;
 use super::quickhull::{quickhull, HullPolygons};
 use super::support::SupportMap;
@@ -49,6 +50,9 @@ pub struct ConvexHull {
     volume: Real,
     /// Boxed to keep `Shape` small.
     unit_mass: Box<MassProperties>,
+    /// The vertices in blocks of four lanes for the support scan (derived, not serialised).
+    #[serde(skip)]
+    lanes: Vec<Block>,
 }
 
 /// The serialised form of a [`ConvexHull`], checked on load by `TryFrom`: at least 4
@@ -115,6 +119,7 @@ fn check_hull_data(d: ConvexHullData) -> Result<ConvexHull> {
         vertices: d.vertices.clone(),
         faces: loops,
     });
+    let lanes = blocks(&d.vertices);
     let stored = ConvexHull {
         vertices: d.vertices,
         faces: d.faces,
@@ -127,6 +132,7 @@ fn check_hull_data(d: ConvexHullData) -> Result<ConvexHull> {
         local_aabb: d.local_aabb,
         volume: d.volume,
         unit_mass: d.unit_mass,
+        lanes,
     };
     if rebuilt != stored {
         return bad(
@@ -214,6 +220,7 @@ impl ConvexHull {
         let local_aabb = Aabb::from_points(vertices.iter().copied());
         let (volume, unit_mass) = scaled_mass_properties(&vertices, &triangles, &local_aabb);
         ConvexHull {
+            lanes: blocks(&vertices),
             vertices,
             faces: hull_faces,
             face_vertex_indices,
@@ -297,18 +304,10 @@ impl ConvexHull {
         best
     }
 
-    /// [`Self::support_vertex`] by scanning every vertex.
+    /// [`Self::support_vertex`] by scanning every vertex, four at a time (the first of the
+    /// largest dot products, as a scalar scan would find).
     fn support_vertex_scan(&self, dir: Vec3) -> usize {
-        let mut best = 0;
-        let mut best_dot = self.vertices[0].dot(dir);
-        for (i, v) in self.vertices.iter().enumerate().skip(1) {
-            let d = v.dot(dir);
-            if d > best_dot {
-                best_dot = d;
-                best = i;
-            }
-        }
-        best
+        support_index(&self.lanes, dir)
     }
 
     /// A triangulation of the faces (fans), counter-clockwise from outside.

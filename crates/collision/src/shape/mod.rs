@@ -12,6 +12,7 @@ pub(crate) mod convex_hull;
 mod cuboid;
 mod cylinder;
 mod heightfield;
+mod hull_lanes;
 mod mass;
 mod mesh_load;
 mod plane;
