@@ -71,6 +71,8 @@ pub struct DynamicsWorld {
     solver_bodies: Vec<SolverBody>,
     /// The solver's constraint and colouring buffers, reused from step to step.
     solver_scratch: SolverScratch,
+    /// The islands' union-find and sleep buffers, reused from step to step.
+    islands: island::IslandScratch,
 }
 
 impl DynamicsWorld {
@@ -83,6 +85,7 @@ impl DynamicsWorld {
             params,
             solver_bodies: Vec::new(),
             solver_scratch: SolverScratch::default(),
+            islands: island::IslandScratch::default(),
         })
     }
 
@@ -102,6 +105,7 @@ impl DynamicsWorld {
             solver_bodies: Vec::new(),
             // Per-step buffers only (rebuilt every step): a restored world starts empty.
             solver_scratch: SolverScratch::default(),
+            islands: island::IslandScratch::default(),
         })
     }
 
@@ -221,8 +225,8 @@ impl DynamicsWorld {
             }
         }
         let mut report = StepReport::default();
-        let roots = island::build(&self.bodies, contacts, &self.joints);
-        report.woken = island::wake_islands(&mut self.bodies, &roots, contacts);
+        island::build(&self.bodies, contacts, &self.joints, &mut self.islands);
+        report.woken = island::wake_islands(&mut self.bodies, &mut self.islands, contacts);
         report.timings.islands = start.elapsed();
 
         integrate::load(&self.bodies, &mut self.solver_bodies);
@@ -253,7 +257,8 @@ impl DynamicsWorld {
                 report.broken_joints.push(jh);
             }
         }
-        report.slept = island::update_sleep(&mut self.bodies, &roots, dt, &self.params.sleep);
+        report.slept =
+            island::update_sleep(&mut self.bodies, &mut self.islands, dt, &self.params.sleep);
         report.timings.store += t.elapsed();
         report.timings.total = start.elapsed();
         Ok(report)
