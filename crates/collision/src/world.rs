@@ -53,10 +53,16 @@ pub struct CollisionObject {
     pub filter: Filter,
     /// World box at the last update (the shape's box expanded by `margin`).
     pub aabb: Aabb,
-    /// Speculative margin (length): the box is expanded by it and a pair generates contact
-    /// points up to `max(prediction, margin_a + margin_b)` apart. A dynamics pipeline sets
-    /// it from the object's motion over the coming step. 0 by default.
+    /// Speculative margin (length): the box is expanded by it (plus `|motion|`) and a pair
+    /// generates contact points up to
+    /// `max(prediction, margin_a + margin_b + |motion_a - motion_b|)` apart. A dynamics
+    /// pipeline sets it from the object's rotation over the coming step. 0 by default.
     pub margin: Real,
+    /// Linear displacement over the coming step (`v dt`), for speculative contacts: a pair
+    /// adds only the *relative* displacement of its two objects to their margins, so bodies
+    /// moving together (a falling column) get no speculative contacts from their common
+    /// motion. Zero by default ([`CollisionWorld::set_motion`]).
+    pub motion: Vec3,
     /// True when hinted resting ([`CollisionWorld::set_resting`]) or static: pairs of two
     /// such objects are not updated by the narrowphase.
     pub resting: bool,
@@ -150,6 +156,7 @@ impl CollisionWorld {
             filter,
             aabb,
             margin: 0.0,
+            motion: Vec3::ZERO,
             resting: filter.is_static,
             handle,
             dirty: false,
@@ -199,6 +206,23 @@ impl CollisionWorld {
             .as_mut()
             .expect("slot checked")
             .margin = margin;
+        Ok(())
+    }
+
+    /// Sets the object's linear displacement over the coming step (see
+    /// [`CollisionObject::motion`]); its box is recomputed at the next update. A non-finite
+    /// motion is an error.
+    pub fn set_motion(&mut self, h: ObjectHandle, motion: Vec3) -> Result<()> {
+        let i = self.slot(h)?;
+        let motion = crate::math::check_finite_vec("motion", motion)?;
+        let o = self.objects[i].as_mut().expect("slot checked");
+        if o.motion != motion {
+            o.motion = motion;
+            if !o.dirty {
+                o.dirty = true;
+                self.dirty.push(i as u32);
+            }
+        }
         Ok(())
     }
 
@@ -253,8 +277,9 @@ impl CollisionWorld {
             }
             o.dirty = false;
             o.aabb = o.shape.aabb(&o.pose);
-            if o.margin > 0.0 {
-                o.aabb = o.aabb.expanded(o.margin);
+            let expand = o.margin + o.motion.length();
+            if expand > 0.0 {
+                o.aabb = o.aabb.expanded(expand);
             }
             self.broadphase
                 .update_proxy(o.handle.proxy(), o.aabb, o.displacement)?;
@@ -279,6 +304,7 @@ impl CollisionWorld {
                 shape: &o.shape,
                 pose: o.pose,
                 margin: o.margin,
+                motion: o.motion,
                 active: !o.resting,
             })
         })?;

@@ -7,7 +7,7 @@
 use super::dispatcher::Dispatcher;
 use super::manifold::ContactManifold;
 use crate::error::Result;
-use crate::math::{Isometry, Real};
+use crate::math::{Isometry, Real, Vec3};
 use crate::shape::Shape;
 use std::collections::BTreeSet;
 
@@ -34,9 +34,12 @@ pub struct NarrowObject<'s> {
     /// Its world pose.
     pub pose: Isometry,
     /// Speculative margin of the object: a pair generates points up to
-    /// `max(config.prediction, margin_a + margin_b)` apart (see
+    /// `max(config.prediction, margin_a + margin_b + |motion_a - motion_b|)` apart (see
     /// [`super::Dispatcher::update_manifold_with_prediction`]).
     pub margin: Real,
+    /// Linear displacement of the object over the coming step: a pair's speculative distance
+    /// counts the relative displacement of its objects, not the sum of their own.
+    pub motion: Vec3,
     /// False for objects that do not move (resting or static): a pair of two inactive
     /// objects keeps its manifold (and impulses) unchanged, as sleeping pairs in Box2D and
     /// Bullet are not updated.
@@ -50,6 +53,7 @@ impl<'s> NarrowObject<'s> {
             shape,
             pose,
             margin: 0.0,
+            motion: Vec3::ZERO,
             active: true,
         }
     }
@@ -266,7 +270,8 @@ impl<H: Copy + Ord + Send + Sync> NarrowPhase<H> {
                 let g = dispatcher.generate(sa, sb, &pa.inv_mul(&pb), true)?;
                 p.touching = g.contacts.iter().any(|(c, _)| c.distance <= 0.0);
             } else {
-                let prediction = oa.margin + ob.margin;
+                // Relative motion: bodies moving together cannot meet through it.
+                let prediction = oa.margin + ob.margin + (oa.motion - ob.motion).length();
                 dispatcher.update_manifold_with_prediction(
                     sa,
                     &pa,
