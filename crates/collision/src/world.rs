@@ -53,15 +53,17 @@ pub struct CollisionObject {
     pub filter: Filter,
     /// World box at the last update (the shape's box expanded by `margin`).
     pub aabb: Aabb,
-    /// Speculative margin (length): the box is expanded by it (plus `|motion|`) and a pair
-    /// generates contact points up to
-    /// `max(prediction, margin_a + margin_b + |motion_a - motion_b|)` apart. A dynamics
-    /// pipeline sets it from the object's rotation over the coming step. 0 by default.
+    /// Speculative margin (length): the box is expanded by it, and a pair generates contact
+    /// points up to `max(prediction, margin_a + margin_b)` apart, less the part of the two
+    /// margins that is linear motion when their motions are set (see
+    /// [`CollisionObject::motion`]). A dynamics pipeline sets it from the object's motion over
+    /// the coming step. 0 by default.
     pub margin: Real,
-    /// Linear displacement over the coming step (`v dt`), for speculative contacts: a pair
-    /// adds only the *relative* displacement of its two objects to their margins, so bodies
-    /// moving together (a falling column) get no speculative contacts from their common
-    /// motion. Zero by default ([`CollisionWorld::set_motion`]).
+    /// Linear displacement over the coming step (`v dt`, included in `margin`), for
+    /// speculative contacts: a pair counts the *relative* displacement of its two objects,
+    /// `margin_a - |motion_a| + margin_b - |motion_b| + |motion_a - motion_b|`, so bodies moving
+    /// together (a falling column) get no speculative contacts from their common motion.
+    /// Zero by default ([`CollisionWorld::set_motion`]); it does not change the box.
     pub motion: Vec3,
     /// True when hinted resting ([`CollisionWorld::set_resting`]) or static: pairs of two
     /// such objects are not updated by the narrowphase.
@@ -210,19 +212,12 @@ impl CollisionWorld {
     }
 
     /// Sets the object's linear displacement over the coming step (see
-    /// [`CollisionObject::motion`]); its box is recomputed at the next update. A non-finite
+    /// [`CollisionObject::motion`]; the margin should include its length). A non-finite
     /// motion is an error.
     pub fn set_motion(&mut self, h: ObjectHandle, motion: Vec3) -> Result<()> {
         let i = self.slot(h)?;
         let motion = crate::math::check_finite_vec("motion", motion)?;
-        let o = self.objects[i].as_mut().expect("slot checked");
-        if o.motion != motion {
-            o.motion = motion;
-            if !o.dirty {
-                o.dirty = true;
-                self.dirty.push(i as u32);
-            }
-        }
+        self.objects[i].as_mut().expect("slot checked").motion = motion;
         Ok(())
     }
 
@@ -277,9 +272,8 @@ impl CollisionWorld {
             }
             o.dirty = false;
             o.aabb = o.shape.aabb(&o.pose);
-            let expand = o.margin + o.motion.length();
-            if expand > 0.0 {
-                o.aabb = o.aabb.expanded(expand);
+            if o.margin > 0.0 {
+                o.aabb = o.aabb.expanded(o.margin);
             }
             self.broadphase
                 .update_proxy(o.handle.proxy(), o.aabb, o.displacement)?;

@@ -34,11 +34,13 @@ pub struct NarrowObject<'s> {
     /// Its world pose.
     pub pose: Isometry,
     /// Speculative margin of the object: a pair generates points up to
-    /// `max(config.prediction, margin_a + margin_b + |motion_a - motion_b|)` apart (see
-    /// [`super::Dispatcher::update_manifold_with_prediction`]).
+    /// `max(config.prediction, margin_a + margin_b)` apart, less the linear motions' share
+    /// (see `motion`; [`super::Dispatcher::update_manifold_with_prediction`]).
     pub margin: Real,
-    /// Linear displacement of the object over the coming step: a pair's speculative distance
-    /// counts the relative displacement of its objects, not the sum of their own.
+    /// Linear displacement of the object over the coming step, included in `margin`: a
+    /// pair's speculative distance counts the relative displacement of its objects,
+    /// `margin_a - |motion_a| + margin_b - |motion_b| + |motion_a - motion_b|`, not the sum
+    /// of their own.
     pub motion: Vec3,
     /// False for objects that do not move (resting or static): a pair of two inactive
     /// objects keeps its manifold (and impulses) unchanged, as sleeping pairs in Box2D and
@@ -271,7 +273,8 @@ impl<H: Copy + Ord + Send + Sync> NarrowPhase<H> {
                 p.touching = g.contacts.iter().any(|(c, _)| c.distance <= 0.0);
             } else {
                 // Relative motion: bodies moving together cannot meet through it.
-                let prediction = oa.margin + ob.margin + (oa.motion - ob.motion).length();
+                let own = |o: &NarrowObject| (o.margin - o.motion.length()).max(0.0);
+                let prediction = own(&oa) + own(&ob) + (oa.motion - ob.motion).length();
                 dispatcher.update_manifold_with_prediction(
                     sa,
                     &pa,

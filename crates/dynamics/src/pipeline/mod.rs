@@ -7,14 +7,14 @@
 //! `btDiscreteDynamicsWorld::internalSingleStepSimulation`:
 //!
 //! 1. **sync** (module `step`): the pose of every awake body goes to its collision object,
-//!    with a speculative margin covering its rotation over the step (`|ω|·dt·r`) and its
-//!    linear displacement (`v·dt`), and
+//!    with a speculative margin covering its motion over the step (`|v|·dt + |ω|·dt·r`) and
+//!    its linear displacement (`v·dt`), and
 //!    sleeping bodies are hinted resting (the broadphase moves them to its resting tree, the
 //!    narrowphase stops updating pairs of two resting objects);
 //! 2. **broadphase and narrowphase** ([`CollisionWorld::update`]): boxes expanded by the
-//!    margins and displacements, pairs, persistent manifolds with points up to
-//!    `margin_a + margin_b + |v_a − v_b|·dt` apart (speculative contacts: the pair's
-//!    *relative* motion, so bodies moving together get none), updated in parallel over pairs;
+//!    margins, pairs, persistent manifolds with points up to the two margins apart, with
+//!    the pair's *relative* linear motion `|v_a − v_b|·dt` in place of `(|v_a| + |v_b|)·dt`
+//!    (speculative contacts; bodies moving together get none), updated in parallel over pairs;
 //! 3. **contacts** (module `contacts`): the persistent manifolds become the solver's
 //!    [`ContactManifold`]s in a reused buffer, skipping sensors, pairs without a dynamic body
 //!    and pairs whose joint disables collisions; their accumulated impulses warm-start;

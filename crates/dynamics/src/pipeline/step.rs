@@ -147,6 +147,8 @@ impl World {
                 // The rotation's sweep goes into the margin, the linear displacement into
                 // the motion: a pair's speculative distance counts the two bodies' relative
                 // displacement (a falling column's boxes get none from their common speed).
+                // The margin (the box's expansion, kept by snapshots) covers both; the motion
+                // lets a pair take the linear part relative to the other body.
                 let (spin, motion) = if speculative {
                     let (v, w) = (set.linear_velocity[i], set.angular_velocity[i]);
                     (w.length() * self.radius[i] * dt, v * dt)
@@ -154,14 +156,14 @@ impl World {
                     (0.0, Vec3::ZERO)
                 };
                 self.collision
-                    .set_pose_with_margin(obj, pose, base + spin)?;
+                    .set_pose_with_margin(obj, pose, base + spin + motion.length())?;
                 self.collision.set_motion(obj, motion)?;
             } else {
                 if info.body_type == BodyType::Static && self.collision.get(obj)?.pose != pose {
                     // A static body teleported through `bodies_mut().set_pose`.
                     self.collision.set_pose(obj, pose)?;
                 }
-                // Asleep or static: no motion (also what a restored snapshot starts from).
+                // Asleep or static: no motion (what a restored snapshot starts from too).
                 if self.collision.get(obj)?.motion != Vec3::ZERO {
                     self.collision.set_motion(obj, Vec3::ZERO)?;
                 }
