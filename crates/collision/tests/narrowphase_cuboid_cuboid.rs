@@ -1,6 +1,6 @@
 //! The box–box manifold settled by the boxes' own separating-axis test (no GJK for apart
 //! pairs), against analytic configurations, the exact box–box query (GJK on apart pairs)
-//! and the guided polyhedron path it replaced.
+//! and the guided polyhedron path it replaced (which clips with the general polyhedron clipper).
 
 mod common;
 
@@ -145,12 +145,14 @@ fn apart_and_overlapping_manifolds_lie_on_the_boxes() {
     assert!(apart_points > 500, "{apart_points}");
 }
 
-/// Overlapping pairs give exactly the manifold of the guided polyhedron path it replaced.
+/// Overlapping pairs give the points of the guided polyhedron path it replaced (its general
+/// clipper against the boxes' axis-aligned one): the same points up to round-off, in any
+/// order, with the same normals and distances.
 #[test]
-fn overlapping_pairs_match_the_guided_path_bit_for_bit() {
+fn overlapping_pairs_match_the_guided_path() {
     let mut rng = Rng::new(5);
     let mut checked = 0;
-    for _ in 0..3000 {
+    for k in 0..3000 {
         let (a, b) = (random_box(&mut rng), random_box(&mut rng));
         let pose = random_pose(&mut rng, 2.0);
         if !matches!(
@@ -163,9 +165,27 @@ fn overlapping_pairs_match_the_guided_path_bit_for_bit() {
         let (pa, pb) = (Polyhedron::from_cuboid(&a), Polyhedron::from_cuboid(&b));
         let (ca, cb) = (ConvexRef::Cuboid(&a), ConvexRef::Cuboid(&b));
         polyhedron_manifold_guided(&pa, &pb, ca, cb, &pose, 0.02, &mut guided);
-        let mut ours = Vec::new();
-        cuboid_cuboid_manifold_into(&a, &b, &pose, 0.02, &mut ours);
-        assert_eq!(ours, guided);
+        let ours = manifold(&a, &b, &pose, 0.02);
+        let tol = 1e-4 * (1.0 + pose.translation.length());
+        let same = |x: &Contact, y: &Contact| {
+            (x.point_a - y.point_a).length() < tol
+                && (x.point_b - y.point_b).length() < tol
+                && (x.normal - y.normal).length() < 1e-4
+                && (x.distance - y.distance).abs() < tol
+        };
+        assert_eq!(ours.len(), guided.len(), "case {k}: {ours:?} vs {guided:?}");
+        for c in &ours {
+            assert!(
+                guided.iter().any(|(g, _)| same(c, g)),
+                "case {k}: {c:?} not in {guided:?}"
+            );
+        }
+        for (g, _) in &guided {
+            assert!(
+                ours.iter().any(|c| same(c, g)),
+                "case {k}: {g:?} not in {ours:?}"
+            );
+        }
         checked += 1;
     }
     assert!(checked > 500, "{checked}");
