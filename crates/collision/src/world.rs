@@ -53,10 +53,18 @@ pub struct CollisionObject {
     pub filter: Filter,
     /// World box at the last update (the shape's box expanded by `margin`).
     pub aabb: Aabb,
-    /// Speculative margin (length): the box is expanded by it and a pair generates contact
-    /// points up to `max(prediction, margin_a + margin_b)` apart. A dynamics pipeline sets
-    /// it from the object's motion over the coming step. 0 by default.
+    /// Speculative margin (length): the box is expanded by it, and a pair generates contact
+    /// points up to `max(prediction, margin_a + margin_b)` apart, less the part of the two
+    /// margins that is linear motion when their motions are set (see
+    /// [`CollisionObject::motion`]). A dynamics pipeline sets it from the object's motion over
+    /// the coming step. 0 by default.
     pub margin: Real,
+    /// Linear displacement over the coming step (`v dt`, included in `margin`), for
+    /// speculative contacts: a pair counts the *relative* displacement of its two objects,
+    /// `margin_a - |motion_a| + margin_b - |motion_b| + |motion_a - motion_b|`, so bodies moving
+    /// together (a falling column) get no speculative contacts from their common motion.
+    /// Zero by default ([`CollisionWorld::set_motion`]); it does not change the box.
+    pub motion: Vec3,
     /// True when hinted resting ([`CollisionWorld::set_resting`]) or static: pairs of two
     /// such objects are not updated by the narrowphase.
     pub resting: bool,
@@ -150,6 +158,7 @@ impl CollisionWorld {
             filter,
             aabb,
             margin: 0.0,
+            motion: Vec3::ZERO,
             resting: filter.is_static,
             handle,
             dirty: false,
@@ -199,6 +208,16 @@ impl CollisionWorld {
             .as_mut()
             .expect("slot checked")
             .margin = margin;
+        Ok(())
+    }
+
+    /// Sets the object's linear displacement over the coming step (see
+    /// [`CollisionObject::motion`]; the margin should include its length). A non-finite
+    /// motion is an error.
+    pub fn set_motion(&mut self, h: ObjectHandle, motion: Vec3) -> Result<()> {
+        let i = self.slot(h)?;
+        let motion = crate::math::check_finite_vec("motion", motion)?;
+        self.objects[i].as_mut().expect("slot checked").motion = motion;
         Ok(())
     }
 
@@ -262,13 +281,14 @@ impl CollisionWorld {
         dirty.clear();
         self.dirty = dirty;
         let ch = self.broadphase.update_pairs();
-        let conv = |v: &[(ProxyHandle, ProxyHandle)]| -> Vec<(ObjectHandle, ObjectHandle)> {
-            v.iter().map(|&(a, b)| (a.into(), b.into())).collect()
+        // Reused buffers: no allocation once they have grown.
+        let conv = |v: &[(ProxyHandle, ProxyHandle)],
+                    out: &mut Vec<(ObjectHandle, ObjectHandle)>| {
+            out.clear();
+            out.extend(v.iter().map(|&(a, b)| (a.into(), b.into())));
         };
-        self.changes = WorldPairChanges {
-            added: conv(&ch.added),
-            removed: conv(&ch.removed),
-        };
+        conv(&ch.added, &mut self.changes.added);
+        conv(&ch.removed, &mut self.changes.removed);
         let mid = Instant::now();
         let objects = &self.objects;
         let (added, removed) = (&self.changes.added, &self.changes.removed);
@@ -278,6 +298,7 @@ impl CollisionWorld {
                 shape: &o.shape,
                 pose: o.pose,
                 margin: o.margin,
+                motion: o.motion,
                 active: !o.resting,
             })
         })?;

@@ -72,9 +72,28 @@ fn is_dynamic(set: &BodySet, i: usize) -> bool {
     set.is_alive(i) && set.info[i].body_type == BodyType::Dynamic
 }
 
-/// The island root of every body slot.
-pub(crate) fn build(set: &BodySet, manifolds: &[ContactManifold], joints: &JointSet) -> Vec<usize> {
-    let mut parent: Vec<usize> = (0..set.capacity()).collect();
+/// The islands' working arrays, owned by the world and reused from step to step (no
+/// allocation once they have grown to the body count).
+#[derive(Debug, Clone, Default)]
+pub(crate) struct IslandScratch {
+    /// Union-find parents, then the island root of every body slot.
+    pub roots: Vec<usize>,
+    /// Per root: the island holds an awake body.
+    awake: Vec<bool>,
+    /// Per root: the smallest rest time of its bodies.
+    min_time: Vec<Real>,
+}
+
+/// Computes the island root of every body slot into `scratch.roots`.
+pub(crate) fn build(
+    set: &BodySet,
+    manifolds: &[ContactManifold],
+    joints: &JointSet,
+    scratch: &mut IslandScratch,
+) {
+    let parent = &mut scratch.roots;
+    parent.clear();
+    parent.extend(0..set.capacity());
     let edges = manifolds
         .iter()
         .filter(|m| !m.points().is_empty())
@@ -87,10 +106,14 @@ pub(crate) fn build(set: &BodySet, manifolds: &[ContactManifold], joints: &Joint
         );
     for (a, b) in edges {
         if is_dynamic(set, a) && is_dynamic(set, b) {
-            union(&mut parent, a, b);
+            union(parent, a, b);
         }
     }
-    (0..parent.len()).map(|i| find(&mut parent, i)).collect()
+    // Full path compression in place: afterwards every slot holds its root.
+    for i in 0..parent.len() {
+        let r = find(parent, i);
+        parent[i] = r;
+    }
 }
 
 /// Wakes every sleeping body whose island holds an awake body or touches a moving kinematic
@@ -98,10 +121,13 @@ pub(crate) fn build(set: &BodySet, manifolds: &[ContactManifold], joints: &Joint
 /// order.
 pub(crate) fn wake_islands(
     set: &mut BodySet,
-    roots: &[usize],
+    scratch: &mut IslandScratch,
     manifolds: &[ContactManifold],
 ) -> Vec<BodyHandle> {
-    let mut awake = vec![false; roots.len()];
+    let roots = &scratch.roots;
+    let awake = &mut scratch.awake;
+    awake.clear();
+    awake.resize(roots.len(), false);
     for i in 0..roots.len() {
         if set.is_awake_dynamic(i) {
             awake[roots[i]] = true;
@@ -139,14 +165,17 @@ pub(crate) fn wake_islands(
 /// asleep, in slot order.
 pub(crate) fn update_sleep(
     set: &mut BodySet,
-    roots: &[usize],
+    scratch: &mut IslandScratch,
     dt: Real,
     params: &SleepParams,
 ) -> Vec<BodyHandle> {
     if !params.enabled {
         return Vec::new();
     }
-    let mut min_time = vec![Real::INFINITY; roots.len()];
+    let roots = &scratch.roots;
+    let min_time = &mut scratch.min_time;
+    min_time.clear();
+    min_time.resize(roots.len(), Real::INFINITY);
     let (lin_sq, ang_sq) = (
         params.linear_threshold * params.linear_threshold,
         params.angular_threshold * params.angular_threshold,

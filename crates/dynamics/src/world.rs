@@ -74,6 +74,8 @@ pub struct DynamicsWorld {
     solver_scratch: SolverScratch,
     /// The solver's joint rows, reused from step to step.
     joint_scratch: JointScratch,
+    /// The islands' union-find and sleep buffers, reused from step to step.
+    islands: island::IslandScratch,
 }
 
 impl DynamicsWorld {
@@ -87,6 +89,7 @@ impl DynamicsWorld {
             solver_bodies: Vec::new(),
             solver_scratch: SolverScratch::default(),
             joint_scratch: JointScratch::default(),
+            islands: island::IslandScratch::default(),
         })
     }
 
@@ -107,6 +110,7 @@ impl DynamicsWorld {
             // Per-step buffers only (rebuilt every step): a restored world starts empty.
             solver_scratch: SolverScratch::default(),
             joint_scratch: JointScratch::default(),
+            islands: island::IslandScratch::default(),
         })
     }
 
@@ -226,8 +230,8 @@ impl DynamicsWorld {
             }
         }
         let mut report = StepReport::default();
-        let roots = island::build(&self.bodies, contacts, &self.joints);
-        report.woken = island::wake_islands(&mut self.bodies, &roots, contacts);
+        island::build(&self.bodies, contacts, &self.joints, &mut self.islands);
+        report.woken = island::wake_islands(&mut self.bodies, &mut self.islands, contacts);
         report.timings.islands = start.elapsed();
 
         integrate::load(&self.bodies, &mut self.solver_bodies);
@@ -259,7 +263,8 @@ impl DynamicsWorld {
                 report.broken_joints.push(jh);
             }
         }
-        report.slept = island::update_sleep(&mut self.bodies, &roots, dt, &self.params.sleep);
+        report.slept =
+            island::update_sleep(&mut self.bodies, &mut self.islands, dt, &self.params.sleep);
         report.timings.store += t.elapsed();
         report.timings.total = start.elapsed();
         Ok(report)

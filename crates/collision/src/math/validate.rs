@@ -81,8 +81,18 @@ pub fn check_unit_quat(name: &str, q: Quat) -> Result<Quat> {
 
 /// Checks a pose: finite translation and unit rotation (renormalised).
 pub fn check_isometry(name: &str, iso: Isometry) -> Result<Isometry> {
-    let translation = check_finite_vec(&format!("{name}.translation"), iso.translation)?;
-    let rotation = check_unit_quat(&format!("{name}.rotation"), iso.rotation)?;
+    // The full names are formatted only on failure: poses are checked on every `set_pose`
+    // (each body at each step), where two `format!`s were most of the cost.
+    let named = |e: CaromError, part: &str| match e {
+        CaromError::InvalidValue { value, reason, .. } => CaromError::InvalidValue {
+            name: format!("{name}.{part}"),
+            value,
+            reason,
+        },
+        e => e,
+    };
+    let translation = check_finite_vec("", iso.translation).map_err(|e| named(e, "translation"))?;
+    let rotation = check_unit_quat("", iso.rotation).map_err(|e| named(e, "rotation"))?;
     Ok(Isometry {
         rotation,
         translation,

@@ -5,6 +5,7 @@
 //! [`Dispatcher::check_pair`] (called when an object is added), never silently skipped.
 
 use super::contact::{ContactList, ContactPoint, FeatureId, NO_FEATURE};
+use super::contact_cuboid_cuboid::cuboid_cuboid_manifold_into;
 use super::convex::{
     capsule_capsule_manifold, capsule_polyhedron_manifold, perturbed_contacts,
     plane_capsule_manifold,
@@ -136,6 +137,10 @@ pub fn convex_convex_into(
             true
         }
         (C::Cuboid(_), C::Triangle(_)) => swapped(out),
+        (C::Cuboid(x), C::Cuboid(y)) => {
+            cuboid_cuboid_manifold_into(x, y, pose_ab, pred, out);
+            true
+        }
         _ => match (as_polyhedron(a), as_polyhedron(b)) {
             (Some(pa), Some(pb)) => {
                 if pa.flat || pb.flat || pa.edges().len() * pb.edges().len() <= SAT_MAX_EDGE_PAIRS {

@@ -205,10 +205,15 @@ impl ContactManifold {
         self.replace_with(&mut new_points, merge_distance);
     }
 
-    /// [`ContactManifold::replace_all`] without allocating: the points are taken from
-    /// `new_points`, which receives the old points' buffer (cleared) for reuse.
+    /// [`ContactManifold::replace_all`] without allocating once the manifold has held
+    /// points: `new_points` is reduced to four in place, matched, copied into the manifold's
+    /// own buffer (sized for [`MAX_MANIFOLD_POINTS`] once) and left empty for reuse. (Swapping
+    /// the two buffers instead handed small or empty buffers around, which then grew again.)
     pub fn replace_with(&mut self, new_points: &mut Vec<ContactPoint>, merge_distance: Real) {
         new_points.retain(|p| p.is_finite());
+        // Reducing before matching keeps the same points as matching first: the reduction
+        // looks at positions and depths only.
+        reduce_points(new_points);
         for p in new_points.iter_mut() {
             if let Some(i) = self.find_match(p, merge_distance) {
                 let old = &self.points[i];
@@ -217,11 +222,12 @@ impl ContactManifold {
                 p.lifetime = old.lifetime;
             }
         }
-        std::mem::swap(&mut self.points, new_points);
-        new_points.clear();
-        if self.points.len() > MAX_MANIFOLD_POINTS {
-            self.reduce();
+        self.points.clear();
+        if self.points.capacity() < MAX_MANIFOLD_POINTS {
+            self.points.reserve_exact(MAX_MANIFOLD_POINTS);
         }
+        self.points.extend_from_slice(new_points);
+        new_points.clear();
     }
 
     /// Reduces to at most four points: keeps the deepest, then the point farthest from it,
@@ -229,70 +235,75 @@ impl ContactManifold {
     /// area outside that triangle (all measured in the plane orthogonal to the deepest
     /// point's normal). Ties keep the earliest point, so the result is deterministic.
     pub fn reduce(&mut self) {
-        let pts = &self.points;
-        if pts.len() <= MAX_MANIFOLD_POINTS {
-            return;
-        }
-        let mut i0 = 0;
-        for (i, p) in pts.iter().enumerate() {
-            if p.distance < pts[i0].distance {
-                i0 = i;
-            }
-        }
-        let n = pts[i0].normal;
-        let proj = |v: Vec3| v - n * v.dot(n);
-        let q: smallvec::SmallVec<[Vec3; 16]> = pts.iter().map(|p| proj(p.point_b)).collect();
-        let argmax = |f: &dyn Fn(usize) -> Real| -> usize {
-            let mut best = 0;
-            let mut best_v = Real::NEG_INFINITY;
-            for i in 0..q.len() {
-                let v = f(i);
-                if v > best_v {
-                    best_v = v;
-                    best = i;
-                }
-            }
-            best
-        };
-        let i1 = argmax(&|i| {
-            if i == i0 {
-                return Real::NEG_INFINITY;
-            }
-            (q[i] - q[i0]).length_squared()
-        });
-        let i2 = argmax(&|i| {
-            if i == i0 || i == i1 {
-                return Real::NEG_INFINITY;
-            }
-            (q[i1] - q[i0]).cross(q[i] - q[i0]).dot(n).abs()
-        });
-        let (i1, i2) = if (q[i1] - q[i0]).cross(q[i2] - q[i0]).dot(n) < 0.0 {
-            (i2, i1)
-        } else {
-            (i1, i2)
-        };
-        // The point most outside the triangle (i0, i1, i2): most negative signed area
-        // against one of its edges.
-        let i3 = argmax(&|i| {
-            if i == i0 || i == i1 || i == i2 {
-                return Real::NEG_INFINITY;
-            }
-            let e = [(i0, i1), (i1, i2), (i2, i0)];
-            e.iter()
-                .map(|&(u, v)| -(q[v] - q[u]).cross(q[i] - q[u]).dot(n))
-                .fold(Real::NEG_INFINITY, Real::max)
-        });
-        let mut keep = [i0, i1, i2, i3];
-        keep.sort_unstable();
-        let mut kept = [pts[0]; MAX_MANIFOLD_POINTS];
-        let mut n = 0;
-        for (k, &i) in keep.iter().enumerate() {
-            if k == 0 || keep[k - 1] != i {
-                kept[n] = pts[i];
-                n += 1;
-            }
-        }
-        self.points.clear();
-        self.points.extend_from_slice(&kept[..n]);
+        reduce_points(&mut self.points);
     }
+}
+
+/// [`ContactManifold::reduce`] on a list of points, in place.
+fn reduce_points(points: &mut Vec<ContactPoint>) {
+    let pts = &*points;
+    if pts.len() <= MAX_MANIFOLD_POINTS {
+        return;
+    }
+    let mut i0 = 0;
+    for (i, p) in pts.iter().enumerate() {
+        if p.distance < pts[i0].distance {
+            i0 = i;
+        }
+    }
+    let n = pts[i0].normal;
+    let proj = |v: Vec3| v - n * v.dot(n);
+    let q: smallvec::SmallVec<[Vec3; 16]> = pts.iter().map(|p| proj(p.point_b)).collect();
+    let argmax = |f: &dyn Fn(usize) -> Real| -> usize {
+        let mut best = 0;
+        let mut best_v = Real::NEG_INFINITY;
+        for i in 0..q.len() {
+            let v = f(i);
+            if v > best_v {
+                best_v = v;
+                best = i;
+            }
+        }
+        best
+    };
+    let i1 = argmax(&|i| {
+        if i == i0 {
+            return Real::NEG_INFINITY;
+        }
+        (q[i] - q[i0]).length_squared()
+    });
+    let i2 = argmax(&|i| {
+        if i == i0 || i == i1 {
+            return Real::NEG_INFINITY;
+        }
+        (q[i1] - q[i0]).cross(q[i] - q[i0]).dot(n).abs()
+    });
+    let (i1, i2) = if (q[i1] - q[i0]).cross(q[i2] - q[i0]).dot(n) < 0.0 {
+        (i2, i1)
+    } else {
+        (i1, i2)
+    };
+    // The point most outside the triangle (i0, i1, i2): most negative signed area
+    // against one of its edges.
+    let i3 = argmax(&|i| {
+        if i == i0 || i == i1 || i == i2 {
+            return Real::NEG_INFINITY;
+        }
+        let e = [(i0, i1), (i1, i2), (i2, i0)];
+        e.iter()
+            .map(|&(u, v)| -(q[v] - q[u]).cross(q[i] - q[u]).dot(n))
+            .fold(Real::NEG_INFINITY, Real::max)
+    });
+    let mut keep = [i0, i1, i2, i3];
+    keep.sort_unstable();
+    let mut kept = [pts[0]; MAX_MANIFOLD_POINTS];
+    let mut n = 0;
+    for (k, &i) in keep.iter().enumerate() {
+        if k == 0 || keep[k - 1] != i {
+            kept[n] = pts[i];
+            n += 1;
+        }
+    }
+    points.clear();
+    points.extend_from_slice(&kept[..n]);
 }

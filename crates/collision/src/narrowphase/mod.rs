@@ -3,8 +3,9 @@
 //!
 //! - [`contact`]: the contact point; [`manifold`]: the persistent manifold;
 //! - [`pipeline`]: the [`NarrowPhase`] stage of the collision world (events, sensors);
-//! - [`polyhedron`]: SAT with Gauss-map pruning and face clipping for boxes (box–box
-//!   clipping), hulls and triangles, and plane–polyhedron; [`convex`]: analytic manifolds for round shapes and
+//! - [`contact_cuboid_cuboid`]: box–box, settled by the boxes' own separating-axis test;
+//! - [`polyhedron`]: SAT with Gauss-map pruning and face clipping for boxes, hulls and
+//!   triangles, and plane–polyhedron; [`convex`]: analytic manifolds for round shapes and
 //!   multi-point by perturbation; [`triangle_cuboid`]: the triangle–box special case of the
 //!   separating-axis test; [`mesh`]: convex against triangle meshes and compounds
 //!   with internal-edge correction; [`dispatcher`]: the shape-pair table.
@@ -16,6 +17,7 @@ pub use contact::{ContactList, ContactPoint, FeatureId, NO_FEATURE};
 pub use manifold::{
     ContactManifold, ManifoldConfig, COHERENCE_ANGLE, COHERENCE_DISTANCE, MAX_MANIFOLD_POINTS,
 };
+pub mod contact_cuboid_cuboid;
 pub mod convex;
 pub mod dispatcher;
 pub mod mesh;

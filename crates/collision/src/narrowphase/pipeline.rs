@@ -7,9 +7,9 @@
 use super::dispatcher::Dispatcher;
 use super::manifold::ContactManifold;
 use crate::error::Result;
-use crate::math::{Isometry, Real};
+use crate::math::{Isometry, Real, Vec3};
 use crate::shape::Shape;
-use std::collections::{BTreeMap, BTreeSet};
+use std::collections::BTreeSet;
 
 /// One pair's state: its manifold and whether it touched at the last step.
 #[derive(Debug, Clone, PartialEq)]
@@ -34,9 +34,14 @@ pub struct NarrowObject<'s> {
     /// Its world pose.
     pub pose: Isometry,
     /// Speculative margin of the object: a pair generates points up to
-    /// `max(config.prediction, margin_a + margin_b)` apart (see
-    /// [`super::Dispatcher::update_manifold_with_prediction`]).
+    /// `max(config.prediction, margin_a + margin_b)` apart, less the linear motions' share
+    /// (see `motion`; [`super::Dispatcher::update_manifold_with_prediction`]).
     pub margin: Real,
+    /// Linear displacement of the object over the coming step, included in `margin`: a
+    /// pair's speculative distance counts the relative displacement of its objects,
+    /// `margin_a - |motion_a| + margin_b - |motion_b| + |motion_a - motion_b|`, not the sum
+    /// of their own.
+    pub motion: Vec3,
     /// False for objects that do not move (resting or static): a pair of two inactive
     /// objects keeps its manifold (and impulses) unchanged, as sleeping pairs in Box2D and
     /// Bullet are not updated.
@@ -50,6 +55,7 @@ impl<'s> NarrowObject<'s> {
             shape,
             pose,
             margin: 0.0,
+            motion: Vec3::ZERO,
             active: true,
         }
     }
@@ -80,11 +86,22 @@ pub struct ContactEvent<H> {
 }
 
 /// Manifolds for every broadphase pair, keyed by object handles `H` (ordered pairs).
+///
+/// The pairs live in one vector sorted by `(a, b)`, the pair order: a step removes and
+/// inserts the broadphase's changes in place (one compaction pass, one backward merge) and
+/// updates the manifolds over the slice in parallel, so the steady state allocates nothing
+/// and the solver reads the manifolds contiguously. (A `BTreeMap` did the same with a node
+/// walk per pair and three vectors collected per step.)
 #[derive(Debug, Clone)]
 pub struct NarrowPhase<H: Ord> {
-    pairs: BTreeMap<(H, H), PairContact<H>>,
+    pairs: Vec<PairContact<H>>,
     sensors: BTreeSet<H>,
     events: Vec<ContactEvent<H>>,
+    /// Per pair, whether it touched before this step's update (reused buffer).
+    was_touching: Vec<bool>,
+    /// Indices of the pairs to remove, then the sorted pairs to add (reused buffers).
+    dead: Vec<usize>,
+    fresh: Vec<(H, H)>,
     /// The dispatcher (algorithms and manifold configuration).
     pub dispatcher: Dispatcher,
 }
@@ -92,11 +109,24 @@ pub struct NarrowPhase<H: Ord> {
 impl<H: Ord> Default for NarrowPhase<H> {
     fn default() -> Self {
         NarrowPhase {
-            pairs: BTreeMap::new(),
+            pairs: Vec::new(),
             sensors: BTreeSet::new(),
             events: Vec::new(),
+            was_touching: Vec::new(),
+            dead: Vec::new(),
+            fresh: Vec::new(),
             dispatcher: Dispatcher::default(),
         }
+    }
+}
+
+fn new_pair<H>(a: H, b: H) -> PairContact<H> {
+    PairContact {
+        a,
+        b,
+        manifold: ContactManifold::new(),
+        touching: false,
+        sensor: false,
     }
 }
 
@@ -104,10 +134,8 @@ impl<H: Copy + Ord + Send + Sync> NarrowPhase<H> {
     /// An empty narrowphase using `dispatcher`.
     pub fn new(dispatcher: Dispatcher) -> Self {
         NarrowPhase {
-            pairs: BTreeMap::new(),
-            sensors: BTreeSet::new(),
-            events: Vec::new(),
             dispatcher,
+            ..Default::default()
         }
     }
 
@@ -121,20 +149,21 @@ impl<H: Copy + Ord + Send + Sync> NarrowPhase<H> {
         }
     }
 
-    /// Creates the manifold of pair `(a, b)`.
+    fn find(&self, a: H, b: H) -> std::result::Result<usize, usize> {
+        self.pairs.binary_search_by(|p| (p.a, p.b).cmp(&(a, b)))
+    }
+
+    /// Creates the manifold of pair `(a, b)` (nothing when it exists).
     pub fn add_pair(&mut self, a: H, b: H) {
-        self.pairs.entry((a, b)).or_insert(PairContact {
-            a,
-            b,
-            manifold: ContactManifold::new(),
-            touching: false,
-            sensor: false,
-        });
+        if let Err(i) = self.find(a, b) {
+            self.pairs.insert(i, new_pair(a, b));
+        }
     }
 
     /// Drops the manifold of pair `(a, b)`; an `End` event is emitted if it touched.
     pub fn remove_pair(&mut self, a: H, b: H) {
-        if let Some(p) = self.pairs.remove(&(a, b)) {
+        if let Ok(i) = self.find(a, b) {
+            let p = self.pairs.remove(i);
             if p.touching {
                 self.events.push(ContactEvent {
                     a,
@@ -146,10 +175,75 @@ impl<H: Copy + Ord + Send + Sync> NarrowPhase<H> {
         }
     }
 
+    /// Removes the pairs `removed` (events in that order) and inserts `added`, keeping the
+    /// pair order, in place: O(pairs) moves, no allocation once the buffers have grown.
+    fn apply_changes(&mut self, added: &[(H, H)], removed: &[(H, H)]) {
+        self.dead.clear();
+        for &(a, b) in removed {
+            if let Ok(i) = self.find(a, b) {
+                let p = &mut self.pairs[i];
+                if p.touching {
+                    // Once, even if `removed` names the pair twice.
+                    p.touching = false;
+                    self.events.push(ContactEvent {
+                        a,
+                        b,
+                        kind: ContactEventKind::End,
+                        sensor: p.sensor,
+                    });
+                }
+                self.dead.push(i);
+            }
+        }
+        if !self.dead.is_empty() {
+            self.dead.sort_unstable();
+            self.dead.dedup();
+            let mut dead = self.dead.iter().copied().peekable();
+            let mut k = 0;
+            self.pairs.retain(|_| {
+                let drop = dead.next_if_eq(&k).is_some();
+                k += 1;
+                !drop
+            });
+        }
+        self.fresh.clear();
+        self.fresh.extend(added.iter().copied().filter(|&(a, b)| {
+            self.pairs
+                .binary_search_by(|p| (p.a, p.b).cmp(&(a, b)))
+                .is_err()
+        }));
+        if self.fresh.is_empty() {
+            return;
+        }
+        // Unique keys: an unstable sort is deterministic.
+        self.fresh.sort_unstable();
+        self.fresh.dedup();
+        // Backward merge: grow by the new pairs, then fill from the end.
+        let old = self.pairs.len();
+        let (a0, b0) = self.fresh[0];
+        self.pairs
+            .resize_with(old + self.fresh.len(), || new_pair(a0, b0));
+        let (mut i, mut j) = (old, self.fresh.len());
+        for w in (0..self.pairs.len()).rev() {
+            if j == 0 {
+                break;
+            }
+            let (fa, fb) = self.fresh[j - 1];
+            if i > 0 && (self.pairs[i - 1].a, self.pairs[i - 1].b) > (fa, fb) {
+                self.pairs.swap(i - 1, w);
+                i -= 1;
+            } else {
+                self.pairs[w] = new_pair(fa, fb);
+                j -= 1;
+            }
+        }
+    }
+
     /// One step: pairs `removed` are dropped and `added` created, then every manifold is
     /// updated from the shapes and poses given by `lookup` (pairs whose objects are unknown,
     /// or both inactive, are skipped and keep their state). Returns the events of this step,
-    /// in pair order (removals first).
+    /// in pair order (removals first). On an error (the first in pair order, whatever the
+    /// thread count) the manifolds may be partly updated and no event is reported.
     pub fn step<'s, F>(
         &mut self,
         added: &[(H, H)],
@@ -160,30 +254,27 @@ impl<H: Copy + Ord + Send + Sync> NarrowPhase<H> {
         F: Fn(H) -> Option<NarrowObject<'s>> + Sync,
     {
         self.events.clear();
-        for &(a, b) in removed {
-            self.remove_pair(a, b);
-        }
-        for &(a, b) in added {
-            self.add_pair(a, b);
-        }
+        self.apply_changes(added, removed);
         let dispatcher = &self.dispatcher;
         let sensors = &self.sensors;
-        let update = |p: &mut PairContact<H>| -> Result<(bool, bool)> {
-            let was = p.touching;
+        let update = |p: &mut PairContact<H>, was: &mut bool| -> Result<()> {
+            *was = p.touching;
             let (Some(oa), Some(ob)) = (lookup(p.a), lookup(p.b)) else {
-                return Ok((was, was));
+                return Ok(());
             };
             if !(oa.active || ob.active) {
-                return Ok((was, was));
+                return Ok(());
             }
             let (sa, pa, sb, pb) = (oa.shape, oa.pose, ob.shape, ob.pose);
-            p.sensor = sensors.contains(&p.a) || sensors.contains(&p.b);
+            p.sensor = !sensors.is_empty() && (sensors.contains(&p.a) || sensors.contains(&p.b));
             if p.sensor {
                 p.manifold.clear();
                 let g = dispatcher.generate(sa, sb, &pa.inv_mul(&pb), true)?;
                 p.touching = g.contacts.iter().any(|(c, _)| c.distance <= 0.0);
             } else {
-                let prediction = oa.margin + ob.margin;
+                // Relative motion: bodies moving together cannot meet through it.
+                let own = |o: &NarrowObject| (o.margin - o.motion.length()).max(0.0);
+                let prediction = own(&oa) + own(&ob) + (oa.motion - ob.motion).length();
                 dispatcher.update_manifold_with_prediction(
                     sa,
                     &pa,
@@ -194,32 +285,45 @@ impl<H: Copy + Ord + Send + Sync> NarrowPhase<H> {
                 )?;
                 p.touching = p.manifold.min_distance().is_some_and(|d| d <= 0.0);
             }
-            Ok((was, p.touching))
+            Ok(())
         };
-        let mut refs: Vec<&mut PairContact<H>> = self.pairs.values_mut().collect();
+        let was = &mut self.was_touching;
+        was.clear();
+        was.resize(self.pairs.len(), false);
         #[cfg(feature = "parallel")]
-        let results: Vec<Result<(bool, bool)>> = {
+        let first_error = {
             use rayon::prelude::*;
-            refs.par_iter_mut().map(|p| update(p)).collect()
+            self.pairs
+                .par_iter_mut()
+                .zip(was.par_iter_mut())
+                .enumerate()
+                .filter_map(|(i, (p, w))| update(p, w).err().map(|e| (i, e)))
+                .min_by_key(|(i, _)| *i)
         };
         #[cfg(not(feature = "parallel"))]
-        let results: Vec<Result<(bool, bool)>> = refs.iter_mut().map(|p| update(p)).collect();
-        let mut events = Vec::new();
-        for (p, r) in refs.iter().zip(results) {
-            let kind = match r? {
+        let first_error = self
+            .pairs
+            .iter_mut()
+            .zip(was.iter_mut())
+            .enumerate()
+            .find_map(|(i, (p, w))| update(p, w).err().map(|e| (i, e)));
+        if let Some((_, e)) = first_error {
+            return Err(e);
+        }
+        for (p, &was) in self.pairs.iter().zip(&self.was_touching) {
+            let kind = match (was, p.touching) {
                 (false, true) => ContactEventKind::Begin,
                 (true, true) => ContactEventKind::Persist,
                 (true, false) => ContactEventKind::End,
                 (false, false) => continue,
             };
-            events.push(ContactEvent {
+            self.events.push(ContactEvent {
                 a: p.a,
                 b: p.b,
                 kind,
                 sensor: p.sensor,
             });
         }
-        self.events.extend(events);
         Ok(&self.events)
     }
 
@@ -230,22 +334,22 @@ impl<H: Copy + Ord + Send + Sync> NarrowPhase<H> {
 
     /// Every pair with its manifold, in pair order.
     pub fn pairs(&self) -> impl Iterator<Item = &PairContact<H>> {
-        self.pairs.values()
+        self.pairs.iter()
     }
 
     /// The pairs with at least one contact point, in pair order (the solver's input).
     pub fn manifolds(&self) -> impl Iterator<Item = &PairContact<H>> {
-        self.pairs.values().filter(|p| !p.manifold.is_empty())
+        self.pairs.iter().filter(|p| !p.manifold.is_empty())
     }
 
     /// Mutable manifolds in pair order (for the solver to store accumulated impulses).
     pub fn manifolds_mut(&mut self) -> impl Iterator<Item = &mut PairContact<H>> {
-        self.pairs.values_mut().filter(|p| !p.manifold.is_empty())
+        self.pairs.iter_mut().filter(|p| !p.manifold.is_empty())
     }
 
     /// Every pair, mutable, in pair order (to restore saved manifolds from a snapshot).
     pub fn pairs_mut(&mut self) -> impl Iterator<Item = &mut PairContact<H>> {
-        self.pairs.values_mut()
+        self.pairs.iter_mut()
     }
 
     /// Replaces the events of the last step (to restore a snapshot).
@@ -255,7 +359,7 @@ impl<H: Copy + Ord + Send + Sync> NarrowPhase<H> {
 
     /// The pair `(a, b)`.
     pub fn get(&self, a: H, b: H) -> Option<&PairContact<H>> {
-        self.pairs.get(&(a, b))
+        self.find(a, b).ok().map(|i| &self.pairs[i])
     }
 
     /// Number of pairs.

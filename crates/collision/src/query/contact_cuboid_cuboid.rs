@@ -172,6 +172,80 @@ pub fn cuboid_cuboid_sat(
     }
 }
 
+/// The axis of least overlap of the two boxes over all 15 axes of [`cuboid_cuboid_sat`],
+/// as `(overlap, normal, axis)` with the unit `normal` from A towards B in A's frame, or
+/// `None` when one axis separates the boxes by more than `prediction`.
+///
+/// Unlike [`cuboid_cuboid_sat`], a separated pair within `prediction` is not handed to GJK:
+/// `overlap` is then negative, minus the largest separation over the 15 axes. That is a
+/// lower bound of the boxes' distance (exact when the closest features are a face and what
+/// lies over it, or two edges), which is what a speculative contact needs: box–box manifolds
+/// clip faces along this axis, as Box3D's `b3CollideBoxes` and parry's
+/// `contact_manifold_cuboid_cuboid` do. For an overlapping pair the result is bit for bit
+/// the overlap branch of [`cuboid_cuboid_sat`] (same axes, same order, first on ties).
+pub fn cuboid_cuboid_axis(
+    a: &Cuboid,
+    b: &Cuboid,
+    pose_ab: &Isometry,
+    prediction: Real,
+) -> Option<(Real, Vec3, Axis)> {
+    let ha = a.half_extents();
+    let hb = b.half_extents();
+    let rot = pose_ab.rotation_matrix();
+    let t = pose_ab.translation;
+    let bx = [rot.x_axis, rot.y_axis, rot.z_axis];
+    let abs_b = [bx[0].abs(), bx[1].abs(), bx[2].abs()];
+    let mut best = (Real::INFINITY, Vec3::ZERO, Axis::FaceA(0));
+    // False when `axis` separates the boxes by more than the prediction.
+    let mut consider = |overlap: Real, dist: Real, axis: Vec3, kind: Axis| -> bool {
+        if overlap < -prediction || overlap.is_nan() {
+            return false;
+        }
+        if overlap < best.0 {
+            best = (overlap, if dist < 0.0 { -axis } else { axis }, kind);
+        }
+        true
+    };
+    // A's faces: B projects on e_i as Σ_j hb_j |b_j · e_i|.
+    let rb_faces = abs_b[0] * hb.x + abs_b[1] * hb.y + abs_b[2] * hb.z;
+    for i in 0..3 {
+        let mut e = Vec3::ZERO;
+        e[i] = 1.0;
+        if !consider(ha[i] + rb_faces[i] - t[i].abs(), t[i], e, Axis::FaceA(i)) {
+            return None;
+        }
+    }
+    // B's faces and the edge pairs: B's projection summed over its three axes, as in
+    // `cuboid_cuboid_sat` (so that both give the same bits).
+    let rb_of = |axis: Vec3| (0..3).map(|k| hb[k] * axis.dot(bx[k]).abs()).sum::<Real>();
+    for (j, &axis) in bx.iter().enumerate() {
+        let ra = ha.x * abs_b[j].x + ha.y * abs_b[j].y + ha.z * abs_b[j].z;
+        let dist = axis.dot(t);
+        if !consider(ra + rb_of(axis) - dist.abs(), dist, axis, Axis::FaceB(j)) {
+            return None;
+        }
+    }
+    for i in 0..3 {
+        let mut e = Vec3::ZERO;
+        e[i] = 1.0;
+        for (j, &axis_b) in bx.iter().enumerate() {
+            let c = e.cross(axis_b);
+            let len = c.length();
+            // Parallel edges: the face axes decide.
+            if len <= 1e3 * EPSILON {
+                continue;
+            }
+            let axis = c / len;
+            let ra = ha.x * axis.x.abs() + ha.y * axis.y.abs() + ha.z * axis.z.abs();
+            let dist = axis.dot(t);
+            if !consider(ra + rb_of(axis) - dist.abs(), dist, axis, Axis::Edge(i, j)) {
+                return None;
+            }
+        }
+    }
+    Some(best)
+}
+
 /// The witness points of an overlap found by [`cuboid_cuboid_sat`].
 pub fn cuboid_cuboid_witness(
     a: &Cuboid,

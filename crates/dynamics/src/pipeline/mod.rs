@@ -7,12 +7,14 @@
 //! `btDiscreteDynamicsWorld::internalSingleStepSimulation`:
 //!
 //! 1. **sync** (module `step`): the pose of every awake body goes to its collision object,
-//!    with a speculative margin covering its motion over the step (`|v|·dt + |ω|·dt·r`), and
+//!    with a speculative margin covering its motion over the step (`|v|·dt + |ω|·dt·r`) and
+//!    its linear displacement (`v·dt`), and
 //!    sleeping bodies are hinted resting (the broadphase moves them to its resting tree, the
 //!    narrowphase stops updating pairs of two resting objects);
 //! 2. **broadphase and narrowphase** ([`CollisionWorld::update`]): boxes expanded by the
-//!    margins, pairs, persistent manifolds with points up to `margin_a + margin_b` apart
-//!    (speculative contacts), updated in parallel over pairs;
+//!    margins, pairs, persistent manifolds with points up to the two margins apart, with
+//!    the pair's *relative* linear motion `|v_a − v_b|·dt` in place of `(|v_a| + |v_b|)·dt`
+//!    (speculative contacts; bodies moving together get none), updated in parallel over pairs;
 //! 3. **contacts** (module `contacts`): the persistent manifolds become the solver's
 //!    [`ContactManifold`]s in a reused buffer, skipping sensors, pairs without a dynamic body
 //!    and pairs whose joint disables collisions; their accumulated impulses warm-start;
@@ -36,9 +38,10 @@
 //!
 //! Speculative contacts (Catto, "Continuous Collision", GDC 2013; Box2D v3 and Rapier's
 //! "soft CCD"): a pair's contact points are generated up to the distance both bodies can
-//! travel in the step, and the solver lets the gap close but not more, so a fast body stops
-//! at the surface it would have crossed. No body is flagged: every body gets a margin from
-//! its own speed.
+//! travel towards each other in the step, and the solver lets the gap close but not more, so
+//! a fast body stops at the surface it would have crossed. No body is flagged: every body
+//! gets a margin from its own speed; a pair counts the relative linear displacement
+//! `|v_a − v_b|·dt` (plus each body's rotational sweep), not the sum of both speeds.
 
 mod contacts;
 pub mod queries;

@@ -4,7 +4,7 @@
 use super::World;
 use crate::body::BodyType;
 use crate::world::StepReport;
-use carom_collision::math::Real;
+use carom_collision::math::{Real, Vec3};
 use carom_collision::{CaromError, Result};
 use std::time::{Duration, Instant};
 
@@ -144,17 +144,29 @@ impl World {
             };
             let pose = set.pose_of(i);
             if moving {
-                let motion = if speculative {
+                // The rotation's sweep goes into the margin, the linear displacement into
+                // the motion: a pair's speculative distance counts the two bodies' relative
+                // displacement (a falling column's boxes get none from their common speed).
+                // The margin (the box's expansion, kept by snapshots) covers both; the motion
+                // lets a pair take the linear part relative to the other body.
+                let (spin, motion) = if speculative {
                     let (v, w) = (set.linear_velocity[i], set.angular_velocity[i]);
-                    (v.length() + w.length() * self.radius[i]) * dt
+                    (w.length() * self.radius[i] * dt, v * dt)
                 } else {
-                    0.0
+                    (0.0, Vec3::ZERO)
                 };
                 self.collision
-                    .set_pose_with_margin(obj, pose, base + motion)?;
-            } else if info.body_type == BodyType::Static && self.collision.get(obj)?.pose != pose {
-                // A static body teleported through `bodies_mut().set_pose`.
-                self.collision.set_pose(obj, pose)?;
+                    .set_pose_with_margin(obj, pose, base + spin + motion.length())?;
+                self.collision.set_motion(obj, motion)?;
+            } else {
+                if info.body_type == BodyType::Static && self.collision.get(obj)?.pose != pose {
+                    // A static body teleported through `bodies_mut().set_pose`.
+                    self.collision.set_pose(obj, pose)?;
+                }
+                // Asleep or static: no motion (what a restored snapshot starts from too).
+                if self.collision.get(obj)?.motion != Vec3::ZERO {
+                    self.collision.set_motion(obj, Vec3::ZERO)?;
+                }
             }
             let resting = !moving;
             if resting != self.resting[i] {
