@@ -262,13 +262,14 @@ impl CollisionWorld {
         dirty.clear();
         self.dirty = dirty;
         let ch = self.broadphase.update_pairs();
-        let conv = |v: &[(ProxyHandle, ProxyHandle)]| -> Vec<(ObjectHandle, ObjectHandle)> {
-            v.iter().map(|&(a, b)| (a.into(), b.into())).collect()
+        // Converted into the previous step's vectors: no allocation in the steady state.
+        let conv = |v: &[(ProxyHandle, ProxyHandle)],
+                    out: &mut Vec<(ObjectHandle, ObjectHandle)>| {
+            out.clear();
+            out.extend(v.iter().map(|&(a, b)| (a.into(), b.into())));
         };
-        self.changes = WorldPairChanges {
-            added: conv(&ch.added),
-            removed: conv(&ch.removed),
-        };
+        conv(&ch.added, &mut self.changes.added);
+        conv(&ch.removed, &mut self.changes.removed);
         let mid = Instant::now();
         let objects = &self.objects;
         let (added, removed) = (&self.changes.added, &self.changes.removed);
