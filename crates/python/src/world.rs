@@ -36,8 +36,8 @@ fn handle(b: u64) -> BodyHandle {
 }
 
 /// A rigid-body world. `gravity` (3,) in m/s², `dt` the step of `step()` in seconds,
-/// `method` the broadphase ("hgrid", "grid", "tree", "tree_manhattan", "sap",
-/// "sort_sweep", "brute_force"), `sleeping` whether resting islands fall asleep, `solver`
+/// `method` the broadphase ("tree", the default, "tree_manhattan", "hgrid", "grid",
+/// "sap", "sort_sweep", "brute_force"), `sleeping` whether resting islands fall asleep, `solver`
 /// "soft_step" (Box2D v3's substepping soft step, the default) or "sequential_impulse"
 /// (Bullet's, with split impulses).
 ///
@@ -70,7 +70,7 @@ impl PyWorld {
 impl PyWorld {
     #[new]
     #[pyo3(signature = (
-        gravity = None, dt = 1.0 / 60.0, method = "hgrid", sleeping = true, solver = "soft_step"
+        gravity = None, dt = 1.0 / 60.0, method = "tree", sleeping = true, solver = "soft_step"
     ))]
     fn new(
         gravity: Option<&Bound<'_, PyAny>>,
