@@ -407,3 +407,42 @@ fn hull_world_aabb_is_the_box_of_the_posed_vertices() {
         }
     }
 }
+
+#[test]
+fn capsule_world_aabb_equals_the_six_support_box() {
+    // The capsule's closed-form box (end spheres) against the box from the exact support
+    // function along the six world axes, near and 1 km from the origin.
+    let mut rng = Rng::new(7);
+    for (radius, half_height) in [(0.3, 0.5), (0.05, 2.0), (1.0, 0.0001)] {
+        let shape = Shape::from(Capsule::new(radius, half_height).unwrap());
+        let convex = shape.as_convex().unwrap();
+        for k in 0..200 {
+            let far = if k % 2 == 0 { 1.0 } else { 1000.0 };
+            let axis = Vec3::new(
+                rng.uniform() - 0.4,
+                rng.uniform() - 0.5,
+                rng.uniform() - 0.6,
+            );
+            let t = Vec3::new(rng.uniform(), rng.uniform(), rng.uniform()) * far;
+            let pose = Isometry::new(
+                t,
+                Quat::from_axis_angle(axis.normalize(), 6.0 * rng.uniform()),
+            );
+            let got = shape.aabb(&pose);
+            let mut lo = Vec3::ZERO;
+            let mut hi = Vec3::ZERO;
+            for i in 0..3 {
+                let mut e = Vec3::ZERO;
+                e[i] = 1.0;
+                hi[i] = pose.transform_point(convex.support(pose.rotation.inverse() * e))[i];
+                lo[i] = pose.transform_point(convex.support(pose.rotation.inverse() * -e))[i];
+            }
+            let tol = 16.0 * Real::EPSILON * (far + 3.0);
+            assert!(
+                (got.min - lo).abs().max_element() <= tol
+                    && (got.max - hi).abs().max_element() <= tol,
+                "{got:?} vs [{lo}, {hi}]"
+            );
+        }
+    }
+}
