@@ -486,6 +486,10 @@ class World:
         method: str = "tree",
         sleeping: bool = True,
         solver: str = "soft_step",
+        substeps: int = 4,
+        iterations: int = 10,
+        simd: bool = True,
+        parallel: bool = True,
     ) -> World: ...
     def add_body(
         self,
