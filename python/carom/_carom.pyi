@@ -447,7 +447,7 @@ class ContactEvents:
 
 @final
 class CollisionWorld:
-    def __new__(cls, method: str = "hgrid") -> CollisionWorld: ...
+    def __new__(cls, method: str = "tree") -> CollisionWorld: ...
     def add(
         self,
         shape: Shape,
@@ -483,7 +483,7 @@ class World:
         cls,
         gravity: Optional[_ArrayLike] = None,
         dt: float = 1.0 / 60.0,
-        method: str = "hgrid",
+        method: str = "tree",
         sleeping: bool = True,
         solver: str = "soft_step",
         substeps: int = 4,

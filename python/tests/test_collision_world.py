@@ -205,7 +205,7 @@ def test_events_begin_persist_end_and_remove() -> None:
 
 def test_sensors_report_events_without_points_and_filters_exclude_pairs() -> None:
     w = carom.CollisionWorld()
-    assert w.method == "hgrid"
+    assert w.method == "tree"
     a = w.add(carom.Sphere(0.5), pose([0, 0, 0]))
     s = w.add(carom.Sphere(0.5), pose([0.5, 0, 0]), sensor=True)
     f = w.add(carom.Sphere(0.5), pose([-0.5, 0, 0]), group=2, mask=2)

@@ -339,3 +339,121 @@ fn two_tree_invariants_hold_after_every_operation() {
         }
     }
 }
+
+#[test]
+fn refit_proxy_keeps_the_tree_valid_tight_and_queries_exact() {
+    // Moves by refitting (the moving tree of the two-tree broadphase): the leaf keeps its
+    // place, its fat box holds the object, the ancestors stay tight (the root box is the
+    // union of the leaves' fat boxes) and box queries equal a brute force over fat boxes.
+    for s in STRATEGIES {
+        for (k, &scene) in SCENES.iter().enumerate() {
+            let mut rng = Rng(700 + k as u64);
+            let mut tree = DynamicTree::new(s, 0.05);
+            let leaves: Vec<TreeProxy> = (0..120)
+                .map(|u| tree.create_proxy(random_box(&mut rng, scene), u).unwrap())
+                .collect();
+            let mut refitted = 0;
+            for _round in 0..5 {
+                for &l in &leaves {
+                    let fat = tree.fat_aabb_of(l).unwrap();
+                    let (nb, d) = moved_box(&mut rng, &fat, scene);
+                    refitted += tree.refit_proxy(l, nb, d).unwrap() as usize;
+                    assert!(tree.fat_aabb_of(l).unwrap().contains(&nb));
+                }
+                tree.validate().unwrap();
+                let all = fat_boxes(&tree, &leaves);
+                let union = all.iter().fold(Aabb::EMPTY, |u, e| u.merge(&e.1));
+                assert_eq!(tree.root_aabb(), Some(union), "root box is tight");
+                for _ in 0..10 {
+                    let q = random_box(&mut rng, scene);
+                    let mut got = BTreeSet::new();
+                    tree.query_aabb(&q, |l, _| got.insert(l));
+                    let expect: BTreeSet<_> = all
+                        .iter()
+                        .filter(|e| e.1.intersects(&q))
+                        .map(|e| e.0)
+                        .collect();
+                    assert_eq!(got, expect);
+                }
+            }
+            assert!(refitted > 100, "moves left the fat boxes: {refitted}");
+            let stale = leaves[0];
+            tree.destroy_proxy(stale).unwrap();
+            assert!(tree
+                .refit_proxy(stale, random_box(&mut rng, scene), Vec3::ZERO)
+                .is_err());
+            let bad = Aabb::new(Vec3::ONE, Vec3::ZERO);
+            assert!(tree.refit_proxy(leaves[1], bad, Vec3::ZERO).is_err());
+        }
+    }
+}
+
+#[test]
+fn refitting_and_reinserting_two_tree_broadphases_report_the_brute_force_pairs() {
+    // The two-tree broadphase with moving proxies refitted (the default) or re-inserted, and
+    // with the pre-tuning margin and motion scale, reports exactly the brute force's pair
+    // changes over frames of motion, sleep/wake, filter changes and removals.
+    use carom_collision::broadphase::{BroadPhase, BruteForce, Filter, TreeBroadPhase};
+    for (k, &scene) in SCENES.iter().enumerate() {
+        let mut rng = Rng(1300 + k as u64);
+        let mut variants: Vec<TreeBroadPhase> = Vec::new();
+        for (refit, margin, scale) in [(true, 0.05, 4.0), (false, 0.05, 4.0), (true, 0.1, 2.0)] {
+            let mut t = TreeBroadPhase::new(InsertStrategy::SurfaceArea, margin);
+            t.refit_moving = refit;
+            t.set_motion_scale(scale);
+            variants.push(t);
+        }
+        let mut oracle = BruteForce::new();
+        let mut live = Vec::new();
+        for _ in 0..80 {
+            let (b, f) = (random_box(&mut rng, scene), Filter::new(rng.below(8) == 0));
+            let h = oracle.create_proxy(b, f).unwrap();
+            for v in &mut variants {
+                assert_eq!(v.create_proxy(b, f).unwrap(), h);
+            }
+            live.push(h);
+        }
+        let mut total = 0;
+        for _frame in 0..12 {
+            for &h in &live {
+                match rng.below(10) {
+                    0..=6 => {
+                        let (nb, d) = moved_box(&mut rng, &oracle.aabb(h).unwrap(), scene);
+                        oracle.update_proxy(h, nb, d).unwrap();
+                        for v in &mut variants {
+                            v.update_proxy(h, nb, d).unwrap();
+                        }
+                    }
+                    7 => {
+                        let r = rng.below(2) == 0;
+                        for v in &mut variants {
+                            v.set_resting(h, r).unwrap();
+                        }
+                    }
+                    8 => {
+                        let f = Filter::new(rng.below(5) == 0);
+                        oracle.set_filter(h, f).unwrap();
+                        for v in &mut variants {
+                            v.set_filter(h, f).unwrap();
+                        }
+                    }
+                    _ => {}
+                }
+            }
+            if live.len() > 40 {
+                let gone = live.remove(rng.below(live.len()));
+                oracle.remove_proxy(gone).unwrap();
+                for v in &mut variants {
+                    v.remove_proxy(gone).unwrap();
+                }
+            }
+            let expect = oracle.update_pairs().clone();
+            total += expect.added.len() + expect.removed.len();
+            for v in &mut variants {
+                assert_eq!(v.update_pairs(), &expect);
+                assert_eq!(v.pairs(), oracle.pairs());
+            }
+        }
+        assert!(total >= 10, "pairs changed: {total}");
+    }
+}

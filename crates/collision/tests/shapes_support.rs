@@ -355,3 +355,94 @@ fn mass_properties_match_tessellations() {
         sphere,
     );
 }
+
+#[test]
+fn hull_world_aabb_is_the_box_of_the_posed_vertices() {
+    // Small hulls get their world box from one pass over rotated vertices, large ones from six
+    // support queries; both must equal the box of the vertices posed one by one (quaternion
+    // transform, an independent formula) to round-off, near and far from the origin.
+    let mut rng = Rng::new(42);
+    let taru = ConvexHull::new(&common::taru_points()).unwrap();
+    let sphere_points: Vec<Vec3> = (0..400)
+        .map(|_| {
+            let d = Vec3::new(
+                rng.uniform() - 0.5,
+                rng.uniform() - 0.5,
+                rng.uniform() - 0.5,
+            );
+            d.normalize_or_zero() * 2.0
+        })
+        .collect();
+    let big = ConvexHull::new(&sphere_points).unwrap();
+    assert!(taru.vertices().len() <= ConvexHull::AABB_SCAN_MAX_VERTICES);
+    assert!(big.vertices().len() > ConvexHull::AABB_SCAN_MAX_VERTICES);
+    for hull in [taru, big] {
+        let shape = Shape::from(hull.clone());
+        for k in 0..200 {
+            let far = if k % 2 == 0 { 1.0 } else { 1000.0 };
+            let axis = Vec3::new(
+                rng.uniform() - 0.4,
+                rng.uniform() - 0.5,
+                rng.uniform() - 0.6,
+            );
+            let t = Vec3::new(rng.uniform(), rng.uniform(), rng.uniform()) * far;
+            let pose = Isometry::new(
+                t,
+                Quat::from_axis_angle(axis.normalize(), 6.0 * rng.uniform()),
+            );
+            let got = shape.aabb(&pose);
+            let (mut lo, mut hi) = (Vec3::splat(Real::MAX), Vec3::splat(Real::MIN));
+            for v in hull.vertices() {
+                let w = pose.transform_point(*v);
+                lo = lo.min(w);
+                hi = hi.max(w);
+            }
+            let tol = 8.0 * Real::EPSILON * (far + 4.0);
+            assert!(
+                (got.min - lo).abs().max_element() <= tol
+                    && (got.max - hi).abs().max_element() <= tol,
+                "{} vertices: {got:?} vs [{lo}, {hi}]",
+                hull.vertices().len()
+            );
+        }
+    }
+}
+
+#[test]
+fn capsule_world_aabb_equals_the_six_support_box() {
+    // The capsule's closed-form box (end spheres) against the box from the exact support
+    // function along the six world axes, near and 1 km from the origin.
+    let mut rng = Rng::new(7);
+    for (radius, half_height) in [(0.3, 0.5), (0.05, 2.0), (1.0, 0.0001)] {
+        let shape = Shape::from(Capsule::new(radius, half_height).unwrap());
+        let convex = shape.as_convex().unwrap();
+        for k in 0..200 {
+            let far = if k % 2 == 0 { 1.0 } else { 1000.0 };
+            let axis = Vec3::new(
+                rng.uniform() - 0.4,
+                rng.uniform() - 0.5,
+                rng.uniform() - 0.6,
+            );
+            let t = Vec3::new(rng.uniform(), rng.uniform(), rng.uniform()) * far;
+            let pose = Isometry::new(
+                t,
+                Quat::from_axis_angle(axis.normalize(), 6.0 * rng.uniform()),
+            );
+            let got = shape.aabb(&pose);
+            let mut lo = Vec3::ZERO;
+            let mut hi = Vec3::ZERO;
+            for i in 0..3 {
+                let mut e = Vec3::ZERO;
+                e[i] = 1.0;
+                hi[i] = pose.transform_point(convex.support(pose.rotation.inverse() * e))[i];
+                lo[i] = pose.transform_point(convex.support(pose.rotation.inverse() * -e))[i];
+            }
+            let tol = 16.0 * Real::EPSILON * (far + 3.0);
+            assert!(
+                (got.min - lo).abs().max_element() <= tol
+                    && (got.max - hi).abs().max_element() <= tol,
+                "{got:?} vs [{lo}, {hi}]"
+            );
+        }
+    }
+}

@@ -202,11 +202,11 @@ pub fn contact_manifold(
 }
 
 /// A collision world: shapes at poses with collision filters, a broadphase (`method`: one
-/// of "tree", "tree_manhattan", "sap", "sort_sweep", "grid", "hgrid", "brute_force") and
-/// persistent contact manifolds per overlapping pair. `add` returns an int handle; move
-/// objects with `set_pose`/`set_poses`, then `step()` runs broadphase, midphase and
-/// narrowphase and returns every manifold point as `Contacts` (normal from A towards B,
-/// `pairs` the handles). `events()` gives begin/persist/end pairs of the last step.
+/// of "tree", the default, "tree_manhattan", "sap", "sort_sweep", "grid", "hgrid",
+/// "brute_force") and persistent contact manifolds per overlapping pair. `add` returns an
+/// int handle; move objects with `set_pose`/`set_poses`, then `step()` runs broadphase,
+/// midphase and narrowphase and returns every manifold point as `Contacts` (normal from A
+/// towards B, `pairs` the handles). `events()` gives begin/persist/end pairs of the last step.
 #[pyclass(name = "CollisionWorld", module = "carom")]
 pub struct PyCollisionWorld {
     world: CollisionWorld,
@@ -228,7 +228,7 @@ impl PyCollisionWorld {
 #[pymethods]
 impl PyCollisionWorld {
     #[new]
-    #[pyo3(signature = (method = "hgrid"))]
+    #[pyo3(signature = (method = "tree"))]
     fn new(method: &str) -> PyResult<Self> {
         let m: Method = core(|| method.parse())?;
         Ok(PyCollisionWorld {

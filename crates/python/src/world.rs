@@ -36,9 +36,9 @@ fn handle(b: u64) -> BodyHandle {
 }
 
 /// A rigid-body world. `gravity` (3,) in m/s², `dt` the step of `step()` in seconds,
-/// `method` the broadphase ("hgrid", "grid", "tree", "tree_manhattan", "sap",
-/// "sort_sweep", "brute_force"), `sleeping` whether resting islands fall asleep, `solver`
-/// "soft_step" (Box2D v3's substepping soft step, the default) or "sequential_impulse"
+/// `method` the broadphase ("tree", the default, "tree_manhattan", "hgrid", "grid",
+/// "sap", "sort_sweep", "brute_force"), `sleeping` whether resting islands fall asleep,
+/// `solver` "soft_step" (Box2D v3's substepping soft step, the default) or "sequential_impulse"
 /// (Bullet's, with split impulses). `substeps` (soft step) and `iterations` (sequential
 /// impulses: velocity and split-impulse iterations) set the solver's effort, each in 1..=1000;
 /// `simd` solves contacts four at a time in SIMD lanes (the same physics as the scalar path);
@@ -73,7 +73,7 @@ impl PyWorld {
 impl PyWorld {
     #[new]
     #[pyo3(signature = (
-        gravity = None, dt = 1.0 / 60.0, method = "hgrid", sleeping = true, solver = "soft_step",
+        gravity = None, dt = 1.0 / 60.0, method = "tree", sleeping = true, solver = "soft_step",
         substeps = 4, iterations = 10, simd = true, parallel = true
     ))]
     #[allow(clippy::too_many_arguments)]

@@ -32,6 +32,12 @@ pub fn build(scene: &Scene, config: EngineConfig) -> Result<Box<dyn Engine>, Str
     params.dynamics.parallel = config.threads > 1;
     // `CAROM_SOLVER_SIMD=off` selects the scalar contact solve (to measure the SIMD one).
     params.dynamics.solver.simd = std::env::var("CAROM_SOLVER_SIMD").map_or(true, |v| v != "off");
+    // `CAROM_BROADPHASE=<method>` selects another broadphase method (to compare them).
+    if let Ok(name) = std::env::var("CAROM_BROADPHASE") {
+        params.broadphase = name
+            .parse()
+            .map_err(|e: carom_collision::CaromError| e.to_string())?;
+    }
     let world = World::from_scene_with(scene, params).map_err(|e| e.to_string())?;
     let handles = world.handles();
     let dynamic = scene

@@ -96,11 +96,43 @@ impl PairCache {
         &self.changes
     }
 
+    /// Like [`PairCache::replace`] for keys that are already sorted, unique and accepted by
+    /// the group/mask rule between live proxies (the user filter, if any, is applied here).
+    /// The keys are swapped in and `keys` receives the previous pair array, so a caller that
+    /// keeps it as its next buffer allocates nothing in the steady state.
+    pub fn replace_accepted(
+        &mut self,
+        store: &mut ProxyStore,
+        keys: &mut Vec<u64>,
+    ) -> &PairChanges {
+        debug_assert!(keys.windows(2).all(|w| w[0] < w[1]), "pairs sorted, unique");
+        debug_assert!(keys.iter().all(|&k| {
+            let (a, b) = unpack_pair(k);
+            let f = store.filters();
+            store.is_alive(a as usize)
+                && store.is_alive(b as usize)
+                && f[a as usize].can_pair(&f[b as usize])
+        }));
+        if let Some(uf) = &self.user_filter {
+            keys.retain(|&k| {
+                let (a, b) = unpack_pair(k);
+                uf(store.handle(a), store.handle(b))
+            });
+        }
+        std::mem::swap(&mut self.keys, keys);
+        Self::diff_into(&mut self.changes, store, keys, &self.keys);
+        store.end_frame();
+        &self.changes
+    }
+
     /// Merges the previous and the new sorted key arrays into added/removed/kept.
     fn diff(&mut self, store: &ProxyStore, keys: Vec<u64>) {
         let old = std::mem::replace(&mut self.keys, keys);
-        let new = &self.keys;
-        let ch = &mut self.changes;
+        Self::diff_into(&mut self.changes, store, &old, &self.keys);
+    }
+
+    /// The changes from the sorted pair keys `old` to `new`.
+    fn diff_into(ch: &mut PairChanges, store: &ProxyStore, old: &[u64], new: &[u64]) {
         ch.added.clear();
         ch.removed.clear();
         ch.kept = 0;

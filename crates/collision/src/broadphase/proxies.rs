@@ -86,12 +86,13 @@ impl ProxyStore {
 
     /// Makes the slots removed since the last call reusable (in a deterministic order).
     pub fn end_frame(&mut self) {
-        self.pending_free.sort_unstable_by(|a, b| b.cmp(a));
-        // Pop from the end of `free` takes the lowest index first.
-        let mut merged: Vec<u32> = self.free.drain(..).collect();
-        merged.append(&mut self.pending_free);
-        merged.sort_unstable_by(|a, b| b.cmp(a));
-        self.free = merged;
+        if self.pending_free.is_empty() {
+            return;
+        }
+        // Descending, so popping from the end of `free` takes the lowest index first. The
+        // indices are distinct, so the unstable sort is deterministic.
+        self.free.append(&mut self.pending_free);
+        self.free.sort_unstable_by(|a, b| b.cmp(a));
     }
 
     /// The box of a live proxy.

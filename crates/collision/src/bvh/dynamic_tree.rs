@@ -259,19 +259,83 @@ impl DynamicTree {
     pub fn move_proxy(&mut self, proxy: TreeProxy, aabb: Aabb, displacement: Vec3) -> Result<bool> {
         let i = self.check(proxy)?;
         crate::math::check_aabb(&aabb)?;
-        let fat = self.nodes[i].aabb;
-        if fat.contains(&aabb) {
-            // Shrink when the object stopped: a fat box far larger than a fresh one would
-            // keep producing useless candidate pairs.
-            let grow =
-                displacement.abs() * (4.0 * self.motion_scale) + Vec3::splat(4.0 * self.margin);
-            if Aabb::new(aabb.min - grow, aabb.max + grow).contains(&fat) {
-                return Ok(false);
-            }
+        Ok(self.move_leaf(i as u32, &aabb, displacement))
+    }
+
+    /// [`DynamicTree::move_proxy`] for a leaf index known to be live and a validated box.
+    pub(crate) fn move_leaf(&mut self, leaf: u32, aabb: &Aabb, displacement: Vec3) -> bool {
+        debug_assert!(
+            self.nodes[leaf as usize].height == 0,
+            "move_leaf on a non-leaf"
+        );
+        if !self.needs_new_fat(leaf as usize, aabb, displacement) {
+            return false;
         }
-        let new_fat = self.fat_aabb(&aabb, displacement);
-        self.move_proxy_fat(i as u32, new_fat);
-        Ok(true)
+        let new_fat = self.fat_aabb(aabb, displacement);
+        self.move_proxy_fat(leaf, new_fat);
+        true
+    }
+
+    /// The fat box of a leaf index known to be live.
+    #[inline]
+    pub(crate) fn leaf_fat(&self, leaf: u32) -> Aabb {
+        self.nodes[leaf as usize].aabb
+    }
+
+    /// Like [`DynamicTree::move_proxy`], but a leaf whose box left its fat box keeps its
+    /// place in the tree: the fat box is replaced and the ancestors are refitted up to the
+    /// first one whose box does not change (Box2D v3's `b2DynamicTree_EnlargeProxy`, which
+    /// refits instead of re-inserting the proxies of moving bodies; rapier's BVH broadphase
+    /// does the same). O(depth) with no sibling search; the topology is only as good as
+    /// it was, which [`DynamicTree::optimize_incremental`] restores over time. Returns
+    /// `true` when the fat box changed.
+    pub fn refit_proxy(
+        &mut self,
+        proxy: TreeProxy,
+        aabb: Aabb,
+        displacement: Vec3,
+    ) -> Result<bool> {
+        let i = self.check(proxy)?;
+        crate::math::check_aabb(&aabb)?;
+        Ok(self.refit_leaf(i as u32, &aabb, displacement))
+    }
+
+    /// [`DynamicTree::refit_proxy`] for a leaf index known to be live and a validated box
+    /// (the broadphase, which owns its leaves and has validated the box, calls this).
+    pub(crate) fn refit_leaf(&mut self, leaf: u32, aabb: &Aabb, displacement: Vec3) -> bool {
+        let i = leaf as usize;
+        debug_assert!(self.nodes[i].height == 0, "refit_leaf on a non-leaf");
+        if !self.needs_new_fat(i, aabb, displacement) {
+            return false;
+        }
+        self.nodes[i].aabb = self.fat_aabb(aabb, displacement);
+        let mut p = self.nodes[i].parent;
+        while p != NULL {
+            let n = self.nodes[p as usize];
+            let merged = self.nodes[n.child1 as usize]
+                .aabb
+                .merge(&self.nodes[n.child2 as usize].aabb);
+            if merged == n.aabb {
+                // The ancestors were computed from this same box: nothing above changes.
+                break;
+            }
+            self.nodes[p as usize].aabb = merged;
+            p = n.parent;
+        }
+        true
+    }
+
+    /// True when leaf `i`'s fat box must be replaced for the object box `aabb` moving by
+    /// `displacement`: the box left it, or the fat box is far larger than a fresh one (the
+    /// object stopped; a stale sweep would keep producing useless candidate pairs).
+    #[inline]
+    fn needs_new_fat(&self, i: usize, aabb: &Aabb, displacement: Vec3) -> bool {
+        let fat = self.nodes[i].aabb;
+        if !fat.contains(aabb) {
+            return true;
+        }
+        let grow = displacement.abs() * (4.0 * self.motion_scale) + Vec3::splat(4.0 * self.margin);
+        !Aabb::new(aabb.min - grow, aabb.max + grow).contains(&fat)
     }
 
     /// Re-inserts leaf `i` with the fat box `fat`. With the Manhattan strategy the search

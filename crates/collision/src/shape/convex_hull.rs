@@ -156,6 +156,10 @@ impl ConvexHull {
     /// vertex adjacency; smaller ones scan all vertices.
     pub const HILL_CLIMB_MIN_VERTICES: usize = 32;
 
+    /// Hulls with at most this many vertices get their world box ([`Shape::aabb`](super::Shape::aabb)) by
+    /// rotating every vertex; larger ones by six hill-climbing support queries.
+    pub const AABB_SCAN_MAX_VERTICES: usize = 64;
+
     /// The convex hull of `points` (quickhull). Duplicate, coplanar and interior points are
     /// handled; at least 4 points are needed and they must span a 3D volume, else a
     /// [`crate::CaromError`] says why (too few, collinear, coplanar, or NaN).
