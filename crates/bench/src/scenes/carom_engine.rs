@@ -38,6 +38,13 @@ pub fn build(scene: &Scene, config: EngineConfig) -> Result<Box<dyn Engine>, Str
             .parse()
             .map_err(|e: carom_collision::CaromError| e.to_string())?;
     }
+    // `CAROM_PARALLEL_MIN_BATCH=n` sets the smallest colour solved in parallel (to measure it).
+    if let Some(n) = std::env::var("CAROM_PARALLEL_MIN_BATCH")
+        .ok()
+        .and_then(|v| v.parse().ok())
+    {
+        params.dynamics.solver.parallel_min_batch = n;
+    }
     let world = World::from_scene_with(scene, params).map_err(|e| e.to_string())?;
     let handles = world.handles();
     let dynamic = scene
