@@ -4,6 +4,10 @@
 //! narrowphase + contact adaptation; solver = solver + islands; integration = integrate).
 //! Sleeping follows the config; threads run the step inside a rayon pool of that size.
 //!
+//! Environment switches for measurements: `CAROM_SOLVER_SIMD=off` (scalar contact solve),
+//! `CAROM_BROADPHASE=<method>` (broadphase other than the default two-tree one) and
+//! `CAROM_PARALLEL_MIN_BATCH=<n>` (smallest colour solved in parallel).
+//!
 //! Rays: each batch builds the world's query structure (`World::query`: a BVH over the
 //! bodies' current boxes, counted in the ray time) and casts every ray closest-first through
 //! it; the batch runs in chunks of 20 rays on the pool (Bullet's `btParallelFor` grain).
