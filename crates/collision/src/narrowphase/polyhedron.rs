@@ -210,6 +210,13 @@ pub const FACE_PREFERENCE: Real = 1.0e-3;
 /// 1.4 mm at 2 cm in the polytope oracle); their witnesses are checked by [`edge_contact`].
 pub const PARALLEL_SIN: Real = 1.0e-5;
 
+/// Relative tolerance (of the reference face's longest edge) within which a vertex counts as
+/// over the reference face: its projection becomes the contact point on the reference shape,
+/// so it may lie off that shape by this much. At `1e-4` the polytope oracle caught points
+/// 0.2-0.3 mm off a triangle of 3 m edges; `1e-5` keeps vertices exactly on a side plane
+/// (coplanar, touching) above f32 round-off.
+const PRISM_TOL: Real = 1.0e-5;
+
 /// A polygon being clipped: points with feature ids, on the stack up to 16 corners.
 type Poly = SmallVec<[(Vec3, u32); 16]>;
 
@@ -298,7 +305,7 @@ pub(crate) fn clip_faces(
                 let a = rv[lp[k] as usize];
                 let b = rv[lp[(k + 1) % lp.len()] as usize];
                 let side = (b - a).cross(nr).normalize_or_zero();
-                side.dot(p - a) <= 1.0e-4 * size
+                side.dot(p - a) <= PRISM_TOL * size
             })
         };
         let depth = |i: usize| iv[i].dot(n_in_inc);
@@ -466,7 +473,7 @@ enum RefFace {
 /// The deepest vertex of the other shape along the normal of face `face` (of A, or of B
 /// given in A's frame by `posed`), as a contact in A's frame with that face's normal; `None`
 /// when the vertex's projection on the face's plane falls outside the face (beyond
-/// `1e-4` of its size), where it would not lie on the reference shape.
+/// [`PRISM_TOL`] of its size), where it would not lie on the reference shape.
 fn sat_point(
     a: &Polyhedron,
     b: &Polyhedron,
@@ -498,7 +505,7 @@ fn sat_point(
         .fold(0.0, Real::max);
     let inside = (0..lp.len()).all(|k| {
         let (u, v) = edge(k);
-        (v - u).cross(normal).normalize_or_zero().dot(on_face - u) <= 1.0e-4 * size
+        (v - u).cross(normal).normalize_or_zero().dot(on_face - u) <= PRISM_TOL * size
     });
     if !inside {
         return None;
