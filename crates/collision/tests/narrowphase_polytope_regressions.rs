@@ -718,3 +718,88 @@ fn edge_witness_off_triangle_far_2() {
     check_pair_tilted(&t, &b, &pr, tilt).unwrap();
     check_pair_tilted(&b, &t, &pr, tilt).unwrap();
 }
+
+/// Found by `bug_hunt_triangle_face_on_far` (f64): dispatcher, box against triangle: overlap 0.00020737086481403821 but no contact.
+/// Open defect, ignored: the triangle–box path reports no contact at an overlap of 0.2 mm
+/// (just above the f64 oracle's tolerance; a nearly parallel pair 1 km out); present before
+/// this round's fixes (it fails with the old clip-miss tolerance too). Root cause not found.
+#[ignore]
+#[test]
+#[allow(clippy::excessive_precision)] // f64 values, rounded in the f32 build
+fn lost_contact_triangle_box_1() {
+    let t = Shape::Triangle(
+        Triangle::new(
+            Vec3::new(1.4113981812897827, 0.34300224840275784, 0.37457259836051415),
+            Vec3::new(-1.1262568351993063, 0.6613301899084245, 0.7376909387287678),
+            Vec3::new(0.7203220530470427, -0.8606744677527722, -0.9951761655368236),
+        )
+        .unwrap(),
+    );
+    let b = Shape::Cuboid(
+        Cuboid::new(Vec3::new(0.8766197232859694, 0.05, 0.15953906759677555)).unwrap(),
+    );
+    let pr = Params {
+        kind: Kind::FaceOn,
+        rot_a: Quat::from_xyzw(
+            0.2780492189262605,
+            0.6752311904821731,
+            0.0,
+            0.6831921188469051,
+        ),
+        rot_b: Quat::from_xyzw(0.0, 0.0, -0.0, 1.0),
+        dir: Vec3::new(0.0, 0.0, -1.0),
+        depth: 0.001,
+        pick: (0.536487054771697, 0.2868307929021842, -0.43251688780116615),
+        far: Vec3::new(0.0, 0.0, 1000.0),
+    };
+    let tilt = Quat::from_xyzw(
+        8.410151425412127e-5,
+        1.604951375881161e-5,
+        -0.00013849083354713072,
+        0.9999999867448186,
+    );
+    check_pair_tilted(&t, &b, &pr, tilt).unwrap();
+    check_pair_tilted(&b, &t, &pr, tilt).unwrap();
+}
+/// Found by `bug_hunt_triangle_face_on_far` (f64): dispatcher, triangle against box: overlap 0.00022456567005946226 but no contact.
+/// Open defect, ignored: the triangle–box path reports no contact at an overlap of 0.2 mm
+/// (just above the f64 oracle's tolerance; a nearly parallel pair 1 km out); present before
+/// this round's fixes (it fails with the old clip-miss tolerance too). Root cause not found.
+#[ignore]
+#[test]
+#[allow(clippy::excessive_precision)] // f64 values, rounded in the f32 build
+fn lost_contact_triangle_box_2() {
+    let t = Shape::Triangle(
+        Triangle::new(
+            Vec3::new(1.05910072744783, 0.9839243688356629, 0.40024803001491494),
+            Vec3::new(0.27955024423136793, 1.2546983436137058, 0.7730353985964719),
+            Vec3::new(0.4344200444434786, -1.0382447085069506, -0.9916285344034041),
+        )
+        .unwrap(),
+    );
+    let b = Shape::Cuboid(
+        Cuboid::new(Vec3::new(0.05, 0.8549889535549564, 0.7996591423691379)).unwrap(),
+    );
+    let pr = Params {
+        kind: Kind::FaceOn,
+        rot_a: Quat::from_xyzw(
+            0.2433461090766029,
+            -0.7079102739908003,
+            0.11579176368748198,
+            0.652869039423444,
+        ),
+        rot_b: Quat::from_xyzw(0.0, 0.0, 0.0, 1.0),
+        dir: Vec3::new(0.7027299807911368, -0.7114566565134438, 0.0),
+        depth: 0.001,
+        pick: (0.0, 0.0, 1.4322826108526385),
+        far: Vec3::new(0.0, 0.0, -1000.0),
+    };
+    let tilt = Quat::from_xyzw(
+        -8.722906481467667e-5,
+        0.00017388855712175945,
+        -6.855173906997991e-5,
+        0.9999999787272593,
+    );
+    check_pair_tilted(&t, &b, &pr, tilt).unwrap();
+    check_pair_tilted(&b, &t, &pr, tilt).unwrap();
+}

@@ -79,7 +79,6 @@ pub fn cuboid_cuboid_sat(
     let mut best: Option<(Real, Vec3, Axis)> = None;
     // The separating axis found, if any (its overlap is negative: minus the gap).
     let mut sep: Option<(Real, Vec3)> = None;
-    let edge_slack = 1.0e3 * EPSILON * (1.0 + ha.max_element() + hb.max_element());
     let mut test = |axis: Vec3, kind: Axis| -> bool {
         let ra = ha.x * axis.x.abs() + ha.y * axis.y.abs() + ha.z * axis.z.abs();
         let rb = (0..3).map(|j| hb[j] * axis.dot(bx[j]).abs()).sum::<Real>();
@@ -90,16 +89,7 @@ pub fn cuboid_cuboid_sat(
             sep = Some((overlap, n));
             return false;
         }
-        // An edge axis must beat the best so far by more than round-off: touching or
-        // coplanar faces make the cross product of two edges in the contact plane the face
-        // normal itself, at the same overlap up to round-off, and those edges' closest
-        // points (the edge witness) need not touch at all.
-        let margin = if matches!(kind, Axis::Edge(..)) {
-            edge_slack
-        } else {
-            0.0
-        };
-        if best.is_none_or(|(d, _, _)| overlap < d - margin) {
+        if best.is_none_or(|(d, _, _)| overlap < d) {
             let n = if dist < 0.0 { -axis } else { axis };
             best = Some((overlap, n, kind));
         }
