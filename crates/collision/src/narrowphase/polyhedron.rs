@@ -210,6 +210,13 @@ pub const FACE_PREFERENCE: Real = 1.0e-3;
 /// 1.4 mm at 2 cm in the polytope oracle); their witnesses are checked by [`edge_contact`].
 pub const PARALLEL_SIN: Real = 1.0e-5;
 
+/// Relative tolerance (of the reference face's longest edge) within which a vertex counts as
+/// over the reference face: its projection becomes the contact point on the reference shape,
+/// so it may lie off that shape by this much. At `1e-4` the polytope oracle caught points
+/// 0.2-0.3 mm off a triangle of 3 m edges; `1e-5` keeps vertices exactly on a side plane
+/// (coplanar, touching) above f32 round-off.
+const PRISM_TOL: Real = 1.0e-5;
+
 /// A polygon being clipped: points with feature ids, on the stack up to 16 corners.
 type Poly = SmallVec<[(Vec3, u32); 16]>;
 
@@ -298,7 +305,7 @@ pub(crate) fn clip_faces(
                 let a = rv[lp[k] as usize];
                 let b = rv[lp[(k + 1) % lp.len()] as usize];
                 let side = (b - a).cross(nr).normalize_or_zero();
-                side.dot(p - a) <= 1.0e-4 * size
+                side.dot(p - a) <= PRISM_TOL * size
             })
         };
         let depth = |i: usize| iv[i].dot(n_in_inc);
@@ -395,7 +402,8 @@ pub(crate) fn polyhedron_manifold_posed(
         }
     }
     // A's face unless B's is the choice (or the better face after a rejected edge pair).
-    if feature == Feature::FaceB || (feature == Feature::Edge && sb > sa) {
+    let ref_b = feature == Feature::FaceB || (feature == Feature::Edge && sb > sa);
+    if ref_b {
         let id_base = ((fb as u32 & 0x3F) | 0x40) << 24;
         let mut tmp: SmallVec<[(Contact, FeatureId); 16]> = SmallVec::new();
         clip_faces(b, fb, a, &pose_ab.inverse(), prediction, id_base, &mut tmp);
@@ -409,66 +417,113 @@ pub(crate) fn polyhedron_manifold_posed(
     }
     let best = sa.max(sb).max(se);
     let slack = FACE_PREFERENCE * (1.0 + best.abs());
+    let reference = if ref_b {
+        RefFace::B(fb)
+    } else {
+        RefFace::A(fa)
+    };
+    let s_ref = if ref_b { sb } else { sa };
     let clipped_min = out[start..]
         .iter()
         .map(|(c, _)| c.distance)
         .fold(Real::INFINITY, Real::min);
-    if out.len() > start && clipped_min > best + slack && (sa >= best || sb >= best) {
-        // The incident face does not hold the deepest vertex (deep or lateral contact):
-        // add the deepest vertex along the SAT's face axis, so the manifold's depth is the
-        // minimum penetration.
-        out.push((sat_point(a, (vb, nb, ob), (sa, fa), fb, best), EPA_FEATURE));
+    if out.len() > start && clipped_min > best + slack && s_ref >= best - slack {
+        // The incident face does not hold the deepest vertex (deep or lateral contact). The
+        // deepest vertex along the reference face's normal joins when it lies over the
+        // reference face (the same normal as the clipped points, the depth the SAT found);
+        // when it lies beside the face its projection would be off the reference shape, so
+        // the clipped points (too shallow alone) give way to the single point below.
+        match sat_point(a, b, posed, reference) {
+            Some(c) => out.push((c, EPA_FEATURE)),
+            None => out.truncate(start),
+        }
     }
     if out.len() == start {
         // The clipped face lies beyond the prediction or beside the reference face while
         // the shapes overlap (the deepest vertex is not on the incident face): one GJK/EPA
         // point on the polyhedra themselves, if it agrees with the SAT's separation (EPA
         // stopping early returns its lower bound, a shallower depth); else the deepest
-        // vertex along the SAT's face axis.
+        // vertex along the SAT's best face axis, when it lies over that face.
         match polyhedron_contact(a, b, pose_ab, prediction) {
             Some(c) if c.distance <= best + slack => {
                 out.push((c, EPA_FEATURE));
             }
             _ if best <= prediction && (sa >= best || sb >= best) => {
-                let c = sat_point(a, (vb, nb, ob), (sa, fa), fb, best);
-                out.push((c, EPA_FEATURE));
+                let face = if sa >= best {
+                    RefFace::A(fa)
+                } else {
+                    RefFace::B(fb)
+                };
+                if let Some(c) = sat_point(a, b, posed, face) {
+                    out.push((c, EPA_FEATURE));
+                }
             }
             _ => {}
         }
     }
 }
 
-/// The deepest vertex along the SAT's best face axis (A's face `fa` when `sa` is the best
-/// separation `best`, else B's face `fb`, given in A's frame by `nb`/`ob`), as a contact in
-/// A's frame. `vb`: B's vertices in A's frame.
+/// A reference face of the separating-axis test: face `.0` of A or of B.
+#[derive(Debug, Clone, Copy)]
+enum RefFace {
+    A(usize),
+    B(usize),
+}
+
+/// The deepest vertex of the other shape along the normal of face `face` (of A, or of B
+/// given in A's frame by `posed`), as a contact in A's frame with that face's normal; `None`
+/// when the vertex's projection on the face's plane falls outside the face (beyond
+/// [`PRISM_TOL`] of its size), where it would not lie on the reference shape.
 fn sat_point(
     a: &Polyhedron,
-    (vb, nb, ob): (&[Vec3], &[Vec3], &[Real]),
-    (sa, fa): (Real, usize),
-    fb: usize,
-    best: Real,
-) -> Contact {
-    if sa >= best {
-        let HullFace { normal, offset, .. } = a.faces[fa];
-        let p = deepest(vb, normal);
-        let d = normal.dot(p) - offset;
-        Contact {
+    b: &Polyhedron,
+    posed: &PosedPolyhedron,
+    face: RefFace,
+) -> Option<Contact> {
+    let (vb, nb, ob) = (&posed.vertices[..], &posed.normals[..], &posed.offsets[..]);
+    let (normal, offset, verts, lp, others) = match face {
+        RefFace::A(f) => {
+            let h = a.faces[f];
+            (h.normal, h.offset, a.vertices(), a.face_loop(f), vb)
+        }
+        RefFace::B(f) => (nb[f], ob[f], vb, b.face_loop(f), a.vertices()),
+    };
+    let p = deepest(others, normal);
+    let d = normal.dot(p) - offset;
+    let on_face = p - normal * d;
+    let edge = |k: usize| {
+        (
+            verts[lp[k] as usize],
+            verts[lp[(k + 1) % lp.len()] as usize],
+        )
+    };
+    let size = (0..lp.len())
+        .map(|k| {
+            let (u, v) = edge(k);
+            (v - u).length()
+        })
+        .fold(0.0, Real::max);
+    let inside = (0..lp.len()).all(|k| {
+        let (u, v) = edge(k);
+        (v - u).cross(normal).normalize_or_zero().dot(on_face - u) <= PRISM_TOL * size
+    });
+    if !inside {
+        return None;
+    }
+    Some(match face {
+        RefFace::A(_) => Contact {
             distance: d,
-            point_a: p - normal * d,
+            point_a: on_face,
             point_b: p,
             normal,
-        }
-    } else {
-        let (m, off) = (nb[fb], ob[fb]);
-        let p = deepest(a.vertices(), m);
-        let d = m.dot(p) - off;
-        Contact {
+        },
+        RefFace::B(_) => Contact {
             distance: d,
             point_a: p,
-            point_b: p - m * d,
-            normal: -m,
-        }
-    }
+            point_b: on_face,
+            normal: -normal,
+        },
+    })
 }
 
 /// The point of `points` with the smallest projection on `n` (first on ties).

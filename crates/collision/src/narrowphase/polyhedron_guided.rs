@@ -2,7 +2,7 @@
 //! and the GJK/EPA contact of two polyhedron views, the fallback of the clipping paths.
 
 use super::contact::FeatureId;
-use super::polyhedron::{clip_faces, polyhedron_manifold_into, Polyhedron};
+use super::polyhedron::{clip_faces, polyhedron_manifold_into, Polyhedron, FACE_PREFERENCE};
 use crate::math::{Isometry, Real, Vec3};
 use crate::query::contact_convex::{contact_gjk_epa_unguarded, GjkEpa};
 use crate::query::contact_cuboid_cuboid::{
@@ -160,8 +160,25 @@ fn cuboid_cuboid_manifold_into(
     }
     if out.len() == start {
         let c = cuboid_cuboid_witness(x, y, pose_ab, depth, n, axis);
+        if matches!(axis, Axis::Edge(..)) && !witness_realises_depth(&c, x, y) {
+            // The edges' closest points do not realise the overlap along the edge axis (the
+            // lines' closest points fall outside the segments; the polytope oracle caught
+            // points 0.5 mm off the box): the full separating-axis test rejects such a pair
+            // and clips faces instead.
+            polyhedron_manifold_into(a, b, pose_ab, prediction, out);
+            return;
+        }
         clip_guided(a, b, c, pose_ab, prediction, out);
     }
+}
+
+/// True when the witness points of `c` are `c.distance` apart along `c.normal` (as
+/// [`super::polyhedron::edge_contact`] requires of an edge pair), up to round-off on
+/// boxes `x` and `y`.
+fn witness_realises_depth(c: &Contact, x: &Cuboid, y: &Cuboid) -> bool {
+    let scale = x.half_extents().max_element() + y.half_extents().max_element();
+    let off = (c.point_b - c.point_a - c.normal * c.distance).length();
+    off <= 1.0e-4 * scale + FACE_PREFERENCE * c.distance.abs()
 }
 
 /// Clips the faces selected by the contact `c` (within about 2.6° of a face normal of A or
@@ -203,12 +220,25 @@ fn clip_guided(
         );
     }
     // Clipping keeps the incident face only; when the deepest point is elsewhere (deep or
-    // lateral contacts) the GJK/EPA point joins, so the manifold's depth stays exact.
+    // lateral contacts) the GJK/EPA point joins, so the manifold's depth stays exact. A
+    // manifold has one normal: when the GJK/EPA normal is not the reference face's (it
+    // may differ by up to `FACE_COS`), the clipped points, too shallow to state the depth,
+    // give way to the GJK/EPA point alone.
     let clipped_min = out[start..]
         .iter()
         .map(|(k, _)| k.distance)
         .fold(Real::INFINITY, Real::min);
     if out.len() == start || clipped_min > c.distance + 1.0e-3 * (1.0 + c.distance.abs()) {
+        let same_normal = out[start..]
+            .iter()
+            .all(|(k, _)| (k.normal - c.normal).length() <= SAME_NORMAL);
+        if !same_normal {
+            out.truncate(start);
+        }
         out.push((c, EPA_FEATURE));
     }
 }
+
+/// Normals closer than this (length of their difference, about 0.006 degrees) count as one
+/// manifold normal.
+const SAME_NORMAL: Real = 1.0e-4;
