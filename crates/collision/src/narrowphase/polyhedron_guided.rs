@@ -175,7 +175,7 @@ fn cuboid_cuboid_manifold_into(
 /// True when the witness points of `c` are `c.distance` apart along `c.normal` (as
 /// [`super::polyhedron::edge_contact`] requires of an edge pair), up to round-off on
 /// boxes `x` and `y`.
-fn witness_realises_depth(c: &Contact, x: &Cuboid, y: &Cuboid) -> bool {
+pub(super) fn witness_realises_depth(c: &Contact, x: &Cuboid, y: &Cuboid) -> bool {
     let scale = x.half_extents().max_element() + y.half_extents().max_element();
     let off = (c.point_b - c.point_a - c.normal * c.distance).length();
     off <= 1.0e-4 * scale + FACE_PREFERENCE * c.distance.abs()
