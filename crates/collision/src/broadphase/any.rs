@@ -122,6 +122,24 @@ impl AnyBroadPhase {
         }
     }
 
+    /// [`BroadPhase::update_proxy`] for a caller that has checked that `proxy` is live, that
+    /// `aabb` is finite with `min <= max` and that `displacement` is finite: the two-tree
+    /// method skips its checks, the others take the checked path.
+    pub(crate) fn update_proxy_checked(
+        &mut self,
+        proxy: ProxyHandle,
+        aabb: &Aabb,
+        displacement: Vec3,
+    ) -> Result<()> {
+        match self {
+            AnyBroadPhase::Tree(b) => {
+                b.update_slot(proxy.index as usize, aabb, displacement);
+                Ok(())
+            }
+            b => b.inner_mut().update_proxy(proxy, *aabb, displacement),
+        }
+    }
+
     fn inner(&self) -> &dyn BroadPhase {
         match self {
             AnyBroadPhase::Tree(b) => b,

@@ -68,6 +68,14 @@ impl ProxyStore {
         Ok(std::mem::replace(&mut self.aabbs[i], aabb))
     }
 
+    /// Sets the box of slot `i`, which the caller knows to be live, with a box it has
+    /// validated (the two-tree broadphase's per-step path from the collision world).
+    #[inline]
+    pub(crate) fn set_aabb_trusted(&mut self, i: usize, aabb: Aabb) {
+        debug_assert!(self.alive[i] && check_aabb(&aabb).is_ok());
+        self.aabbs[i] = aabb;
+    }
+
     /// Sets the filter of a live proxy.
     pub fn set_filter(&mut self, proxy: ProxyHandle, filter: Filter) -> Result<()> {
         let i = self.check(proxy)?;

@@ -144,6 +144,24 @@ impl TreeBroadPhase {
         self.leaves[i] = (to, new_leaf);
     }
 
+    /// [`BroadPhase::update_proxy`] without the checks, for a caller that has checked the
+    /// handle (slot `i` is live), the box (finite, `min <= max`) and the displacement
+    /// (finite): the collision world's per-step sync, where the checks were a third of the
+    /// update's instructions.
+    pub(crate) fn update_slot(&mut self, i: usize, aabb: &Aabb, displacement: Vec3) {
+        self.store.set_aabb_trusted(i, *aabb);
+        let (t, leaf) = self.leaves[i];
+        let changed = if t == MOVING && self.refit_moving {
+            self.trees[t].refit_leaf(leaf.index, aabb, displacement)
+        } else {
+            self.trees[t].move_leaf(leaf.index, aabb, displacement)
+        };
+        if changed {
+            self.fat[i] = self.trees[t].leaf_fat(leaf.index);
+            self.mark_moved(i as u32);
+        }
+    }
+
     /// Adds to `out` the candidate keys of moved proxy `m` against tree `t`. A pair of two
     /// moved proxies is reported only by the lower one (when both query, as Box2D v3's
     /// `b2PairQueryCallback`), so fewer duplicate keys reach the sort.
@@ -193,16 +211,7 @@ impl BroadPhase for TreeBroadPhase {
         }
         // Validates the box; the leaf is ours and live, so the tree skips its own checks.
         self.store.set_aabb(proxy, aabb)?;
-        let (t, leaf) = self.leaves[i];
-        let changed = if t == MOVING && self.refit_moving {
-            self.trees[t].refit_leaf(leaf.index, &aabb, displacement)
-        } else {
-            self.trees[t].move_leaf(leaf.index, &aabb, displacement)
-        };
-        if changed {
-            self.fat[i] = self.trees[t].leaf_fat(leaf.index);
-            self.mark_moved(i as u32);
-        }
+        self.update_slot(i, &aabb, displacement);
         Ok(())
     }
 

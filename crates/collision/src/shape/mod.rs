@@ -273,7 +273,22 @@ impl Shape {
             Shape::Sphere(s) => {
                 Aabb::from_center_half_extents(pose.translation, Vec3::splat(s.radius()))
             }
-            Shape::Cuboid(s) => s.local_aabb().transformed(pose),
+            Shape::Cuboid(s) => {
+                // Arvo's box of a centred box: the half extents through |R| (the centre is the
+                // translation, so no rotation of the local centre).
+                let m = crate::math::Mat3::from_quat(pose.rotation);
+                let h = s.half_extents();
+                let e = m.x_axis.abs() * h.x + m.y_axis.abs() * h.y + m.z_axis.abs() * h.z;
+                Aabb::new(pose.translation - e, pose.translation + e)
+            }
+            Shape::Cylinder(c) => {
+                let (lo, hi) = axial_extents(pose, c.radius(), c.half_height(), false);
+                Aabb::new(pose.translation + lo, pose.translation + hi)
+            }
+            Shape::Cone(c) => {
+                let (lo, hi) = axial_extents(pose, c.radius(), c.half_height(), true);
+                Aabb::new(pose.translation + lo, pose.translation + hi)
+            }
             Shape::HeightField(s) => s.local_aabb().transformed(pose),
             Shape::Plane(p) => {
                 let n = pose.transform_vector(p.normal());
@@ -402,3 +417,31 @@ macro_rules! impl_from {
 impl_from!(Sphere => Sphere, Cuboid => Cuboid, Capsule => Capsule, Cylinder => Cylinder,
     Cone => Cone, ConvexHull => ConvexHull, Triangle => Triangle, Plane => Plane,
     TriMesh => TriMesh, Compound => Compound, Scaled => Scaled, HeightField => HeightField);
+
+/// World-axis extents (offsets of the box's min and max corners from the centre) of a
+/// cylinder or cone of base `radius` along its local y axis from `-half_height` to
+/// `half_height`, placed at `pose` (the cone's apex at `+half_height`). Closed forms instead
+/// of six support queries: a disk of radius `r` with unit normal `a` spans
+/// `±r·sqrt(1 − a_i²)` along world axis `i` (the "Bounding box of a disk" of Íñigo Quílez's
+/// articles; parry's `Cylinder::aabb` does the same), and the box spans both end disks (the
+/// cone's apex is a disk of radius 0). Equal to the support-query box up to round-off.
+#[inline]
+fn axial_extents(pose: &Isometry, radius: Real, half_height: Real, cone: bool) -> (Vec3, Vec3) {
+    let a = pose.rotation * Vec3::Y;
+    // `1 − a_i²` as the sum of the two other squares: no cancellation when the axis is
+    // nearly aligned with a world axis (`1 − a_y²` would lose the `√ε`-sized radius there).
+    let sq = a * a;
+    let disk = Vec3::new(
+        (sq.y + sq.z).sqrt(),
+        (sq.z + sq.x).sqrt(),
+        (sq.x + sq.y).sqrt(),
+    ) * radius;
+    let top = a * half_height;
+    if cone {
+        // Apex at +h (no disk), base disk at -h.
+        (top.min(-top - disk), top.max(-top + disk))
+    } else {
+        let t = top.abs();
+        (-(t + disk), t + disk)
+    }
+}

@@ -116,6 +116,8 @@ pub struct World {
     /// Time not yet simulated by [`World::step_simulation`].
     accumulator: Real,
     report: PipelineReport,
+    /// The scene-query tree kept between [`World::query`] calls.
+    query_cache: queries::QueryCache,
 }
 
 impl World {
@@ -140,6 +142,7 @@ impl World {
             disabled: Vec::new(),
             accumulator: 0.0,
             report: PipelineReport::default(),
+            query_cache: Default::default(),
         })
     }
 

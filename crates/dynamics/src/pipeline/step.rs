@@ -144,6 +144,13 @@ impl World {
                 BodyType::Static => false,
             };
             let pose = set.pose_of(i);
+            // The resting hint first: the two-tree broadphase migrates the leaf with its
+            // current fat box, and the box update below then refits it in its new tree.
+            let resting = !moving;
+            if resting != self.resting[i] {
+                self.collision.set_resting(obj, resting)?;
+                self.resting[i] = resting;
+            }
             if moving {
                 // The rotation's sweep goes into the margin, the linear displacement into
                 // the motion: a pair's speculative distance counts the two bodies' relative
@@ -156,23 +163,20 @@ impl World {
                 } else {
                     (0.0, Vec3::ZERO)
                 };
+                // Pose, margin, motion, box and broadphase proxy in one call.
                 self.collision
-                    .set_pose_with_margin(obj, pose, base + spin + motion.length())?;
-                self.collision.set_motion(obj, motion)?;
+                    .sync_object(obj, pose, base + spin + motion.length(), motion)?;
             } else {
-                if info.body_type == BodyType::Static && self.collision.get(obj)?.pose != pose {
+                let o = self.collision.get(obj)?;
+                let (teleported, has_motion) = (o.pose != pose, o.motion != Vec3::ZERO);
+                if info.body_type == BodyType::Static && teleported {
                     // A static body teleported through `bodies_mut().set_pose`.
                     self.collision.set_pose(obj, pose)?;
                 }
                 // Asleep or static: no motion (what a restored snapshot starts from too).
-                if self.collision.get(obj)?.motion != Vec3::ZERO {
+                if has_motion {
                     self.collision.set_motion(obj, Vec3::ZERO)?;
                 }
-            }
-            let resting = !moving;
-            if resting != self.resting[i] {
-                self.collision.set_resting(obj, resting)?;
-                self.resting[i] = resting;
             }
         }
         Ok(())
