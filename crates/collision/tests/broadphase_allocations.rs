@@ -1,8 +1,11 @@
 //! The two-tree broadphase allocates nothing per update in the steady state: boxes that
 //! jitter inside and out of their fat boxes (refits, queries, candidate merges, pair diffs)
-//! reuse the buffers grown during a warm-up.
+//! reuse the buffers grown during a warm-up. The hashed grid and the hierarchical grid
+//! (rebuilt from scratch at every update) reuse theirs too.
 
-use carom_collision::broadphase::{BroadPhase, Filter, ProxyHandle, TreeBroadPhase};
+use carom_collision::broadphase::{
+    AnyBroadPhase, BroadPhase, Filter, Method, ProxyHandle, TreeBroadPhase,
+};
 use carom_collision::math::{Aabb, Real, Vec3};
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
@@ -43,7 +46,7 @@ static GLOBAL: Counting = Counting;
 
 /// A 10×10×10 lattice of unit boxes 0.05 apart (neighbours pair through their margins),
 /// each displaced by `phase`-dependent wobble of up to 0.12 (beyond the fat margin).
-fn frame(bp: &mut TreeBroadPhase, handles: &[ProxyHandle], step: usize) -> usize {
+fn frame(bp: &mut impl BroadPhase, handles: &[ProxyHandle], step: usize) -> usize {
     for (k, &h) in handles.iter().enumerate() {
         let (i, j, l) = ((k % 10) as Real, ((k / 10) % 10) as Real, (k / 100) as Real);
         let phase = (step * 7 + k * 13) % 24;
@@ -81,4 +84,48 @@ fn a_steady_tree_broadphase_update_allocates_nothing() {
     assert!(pairs > 500, "the lattice pairs: {pairs}");
     assert!(changes > 100, "pairs came and went: {changes}");
     assert_eq!(count, 0, "allocations in 48 steady updates");
+}
+
+#[test]
+fn steady_grid_updates_allocate_nothing() {
+    // The lattice, plus a few larger boxes (other hierarchy levels) and a huge one (the
+    // oversize list). Run on a rayon worker, as the pipeline does (`pool.install`): a
+    // parallel loop started from outside a pool goes through rayon's injector queue, which
+    // allocates a block now and then whatever the caller does.
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(2)
+        .build()
+        .unwrap();
+    for method in [Method::Grid, Method::HGrid] {
+        let mut bp = AnyBroadPhase::new(method);
+        let handles: Vec<ProxyHandle> = (0..1000)
+            .map(|_| {
+                bp.create_proxy(Aabb::new(Vec3::ZERO, Vec3::ONE), Filter::default())
+                    .unwrap()
+            })
+            .collect();
+        for k in 0..6 {
+            let c = Vec3::new(3.0 * k as Real, 11.0, 2.0);
+            let size = if k == 5 { 1.0e4 } else { 1.5 + k as Real };
+            bp.create_proxy(Aabb::new(c, c + Vec3::splat(size)), Filter::new(true))
+                .unwrap();
+        }
+        let (pairs, changes, count) = pool.install(|| {
+            for step in 0..48 {
+                frame(&mut bp, &handles, step);
+            }
+            let pairs = bp.pair_count();
+            COUNT.with(|n| n.set(0));
+            COUNTING.with(|c| c.set(true));
+            let mut changes = 0;
+            for step in 48..96 {
+                changes += frame(&mut bp, &handles, step);
+            }
+            COUNTING.with(|c| c.set(false));
+            (pairs, changes, COUNT.with(|n| n.get()))
+        });
+        assert!(pairs > 500, "{method:?}: the lattice pairs: {pairs}");
+        assert!(changes > 100, "{method:?}: pairs came and went: {changes}");
+        assert_eq!(count, 0, "{method:?}: allocations in 48 steady updates");
+    }
 }

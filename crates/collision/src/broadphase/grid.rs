@@ -66,13 +66,17 @@ impl CellEntry {
     }
 }
 
-/// One level of a (hierarchical) hashed grid: sorted cell entries.
+/// One level of a (hierarchical) hashed grid: sorted cell entries. Rebuilt in place at
+/// every update ([`GridLevel::rebuild`]), so its buffers are reused.
 #[derive(Debug, Clone, Default)]
 pub struct GridLevel {
     /// Inverse cell size.
     pub inv: Real,
     /// Entries sorted by key.
     pub entries: Vec<CellEntry>,
+    /// Group boundaries and per-group pair buffers of [`GridLevel::self_pairs`].
+    cuts: Vec<usize>,
+    parts: Vec<Vec<u64>>,
 }
 
 impl GridLevel {
@@ -83,8 +87,24 @@ impl GridLevel {
         cell_size: Real,
         scratch: &mut Vec<CellEntry>,
     ) -> Self {
+        let mut level = GridLevel::default();
+        level.rebuild(boxes, ids, cell_size, scratch);
+        level
+    }
+
+    /// [`GridLevel::build`] into this level, reusing its buffers (no allocation once they
+    /// have grown).
+    pub fn rebuild(
+        &mut self,
+        boxes: &[Aabb],
+        ids: &[u32],
+        cell_size: Real,
+        scratch: &mut Vec<CellEntry>,
+    ) {
         let inv = 1.0 / cell_size;
-        let mut entries = Vec::with_capacity(ids.len() * 2);
+        self.inv = inv;
+        let entries = &mut self.entries;
+        entries.clear();
         for &id in ids {
             let b = &boxes[id as usize];
             let (lo, hi) = (cell_of(b.min, inv), cell_of(b.max, inv));
@@ -104,17 +124,19 @@ impl GridLevel {
         }
         // Entries were pushed in id order and the radix sort is stable: sorting on the hash
         // alone leaves each bucket in id order (3 passes instead of 5).
-        radix_sort_by_key(&mut entries, scratch, |e| e.key >> 32);
-        GridLevel { inv, entries }
+        radix_sort_by_key(entries, scratch, |e| e.key >> 32);
     }
 
     /// Pairs among the boxes of this level, each reported once (in its lowest common cell).
-    /// Buckets are processed in parallel in fixed-size groups (the output is sorted later).
-    pub fn self_pairs(&self, boxes: &[Aabb], out: &mut Vec<u64>) {
+    /// Buckets are processed in parallel in fixed-size groups, whose results are appended
+    /// in group order (the output does not depend on the thread count; it is sorted later).
+    pub fn self_pairs(&mut self, boxes: &[Aabb], out: &mut Vec<u64>) {
         // Bucket boundaries, then groups of about PAIR_CHUNK entries cut at boundaries.
         const PAIR_CHUNK: usize = 4096;
         let e = &self.entries;
-        let mut cuts = vec![0usize];
+        let cuts = &mut self.cuts;
+        cuts.clear();
+        cuts.push(0);
         let mut i = 0;
         while i < e.len() {
             let h = e[i].key >> 32;
@@ -126,55 +148,29 @@ impl GridLevel {
                 cuts.push(i);
             }
         }
-        let run = |lo: usize, hi: usize| {
-            let mut out = Vec::new();
-            self.pairs_in(boxes, lo, hi, &mut out);
-            out
+        let groups = cuts.len() - 1;
+        if self.parts.len() < groups {
+            self.parts.resize_with(groups, Vec::new);
+        }
+        let inv = self.inv;
+        let run = |w: &[usize], part: &mut Vec<u64>| {
+            part.clear();
+            pairs_in(e, inv, boxes, w[0], w[1], part);
         };
+        let parts = &mut self.parts[..groups];
         #[cfg(feature = "parallel")]
         {
             use rayon::prelude::*;
-            let parts: Vec<Vec<u64>> = cuts.par_windows(2).map(|w| run(w[0], w[1])).collect();
-            for p in parts {
-                out.extend_from_slice(&p);
-            }
+            cuts.par_windows(2)
+                .zip(parts.par_iter_mut())
+                .for_each(|(w, part)| run(w, part));
         }
         #[cfg(not(feature = "parallel"))]
-        for w in cuts.windows(2) {
-            out.extend_from_slice(&run(w[0], w[1]));
+        for (w, part) in cuts.windows(2).zip(parts.iter_mut()) {
+            run(w, part);
         }
-    }
-
-    /// Pairs within the buckets that make up `entries[lo..hi]`.
-    fn pairs_in(&self, boxes: &[Aabb], lo: usize, hi: usize, out: &mut Vec<u64>) {
-        let e = &self.entries[..hi];
-        let mut start = lo;
-        while start < hi {
-            let h = e[start].key >> 32;
-            let mut end = start + 1;
-            while end < hi && e[end].key >> 32 == h {
-                end += 1;
-            }
-            for p in start..end {
-                let ep = e[p];
-                let ba = &boxes[ep.id() as usize];
-                for eq in &e[p + 1..end] {
-                    if ep.cell != eq.cell {
-                        continue;
-                    }
-                    let b = eq.id();
-                    let bb = &boxes[b as usize];
-                    if ba.intersects(bb)
-                        && ep.id() != b
-                        && (ep.single
-                            || eq.single
-                            || cell_of(ba.min.max(bb.min), self.inv) == ep.cell)
-                    {
-                        out.push(pair_key(ep.id(), b));
-                    }
-                }
-            }
-            start = end;
+        for p in parts.iter() {
+            out.extend_from_slice(p);
         }
     }
 
@@ -203,6 +199,45 @@ impl GridLevel {
                 }
             }
         }
+    }
+}
+
+/// Pairs within the buckets that make up `entries[lo..hi]` of a level with inverse cell
+/// size `inv`.
+fn pairs_in(
+    entries: &[CellEntry],
+    inv: Real,
+    boxes: &[Aabb],
+    lo: usize,
+    hi: usize,
+    out: &mut Vec<u64>,
+) {
+    let e = &entries[..hi];
+    let mut start = lo;
+    while start < hi {
+        let h = e[start].key >> 32;
+        let mut end = start + 1;
+        while end < hi && e[end].key >> 32 == h {
+            end += 1;
+        }
+        for p in start..end {
+            let ep = e[p];
+            let ba = &boxes[ep.id() as usize];
+            for eq in &e[p + 1..end] {
+                if ep.cell != eq.cell {
+                    continue;
+                }
+                let b = eq.id();
+                let bb = &boxes[b as usize];
+                if ba.intersects(bb)
+                    && ep.id() != b
+                    && (ep.single || eq.single || cell_of(ba.min.max(bb.min), inv) == ep.cell)
+                {
+                    out.push(pair_key(ep.id(), b));
+                }
+            }
+        }
+        start = end;
     }
 }
 
@@ -244,6 +279,31 @@ pub struct HashGrid {
     /// Fixed cell size; `None` picks the median largest box extent at each update.
     pub cell_size: Option<Real>,
     scratch: Vec<CellEntry>,
+    /// Buffers reused by every update (no allocation in the steady state).
+    bufs: GridBuffers,
+    level: GridLevel,
+}
+
+/// Per-update buffers of the grids, kept between updates.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct GridBuffers {
+    pub live: Vec<u32>,
+    pub ext: Vec<Real>,
+    pub big: Vec<u32>,
+    pub small: Vec<u32>,
+    pub is_big: Vec<bool>,
+    pub keys: Vec<u64>,
+}
+
+impl GridBuffers {
+    /// Clears the lists and sizes `is_big` to `capacity` slots, all false.
+    pub fn reset(&mut self, capacity: usize) {
+        self.big.clear();
+        self.small.clear();
+        self.keys.clear();
+        self.is_big.clear();
+        self.is_big.resize(capacity, false);
+    }
 }
 
 impl HashGrid {
@@ -262,39 +322,47 @@ impl BroadPhase for HashGrid {
     }
 
     fn update_pairs(&mut self) -> &PairChanges {
-        let live = self.store.live_indices();
+        let b = &mut self.bufs;
+        self.store.live_indices_into(&mut b.live);
         let boxes = self.store.aabbs();
-        let cell = self.cell_size.unwrap_or_else(|| {
-            // The median largest extent: robust to a few huge boxes (planes).
-            let mut ext: Vec<Real> = live
-                .iter()
-                .map(|&i| boxes[i as usize].extents().max_element())
-                .collect();
-            let m = ext.len() / 2;
-            let median = if ext.is_empty() {
-                0.0
-            } else {
-                *ext.select_nth_unstable_by(m, |a, b| a.total_cmp(b)).1
-            };
-            if median > 0.0 && median.is_finite() {
-                median
-            } else {
-                1.0
+        let cell = match self.cell_size {
+            Some(c) => c,
+            None => {
+                // The median largest extent: robust to a few huge boxes (planes).
+                b.ext.clear();
+                b.ext.extend(
+                    b.live
+                        .iter()
+                        .map(|&i| boxes[i as usize].extents().max_element()),
+                );
+                let m = b.ext.len() / 2;
+                let median = if b.ext.is_empty() {
+                    0.0
+                } else {
+                    *b.ext.select_nth_unstable_by(m, |a, b| a.total_cmp(b)).1
+                };
+                if median > 0.0 && median.is_finite() {
+                    median
+                } else {
+                    1.0
+                }
             }
-        });
+        };
         let inv = 1.0 / cell;
-        let mut is_big = vec![false; self.store.capacity()];
-        let (big, small): (Vec<u32>, Vec<u32>) = live
-            .iter()
-            .partition(|&&i| cell_count(&boxes[i as usize], inv) > MAX_CELLS_PER_BOX);
-        for &b in &big {
-            is_big[b as usize] = true;
+        b.reset(self.store.capacity());
+        for &i in &b.live {
+            if cell_count(&boxes[i as usize], inv) > MAX_CELLS_PER_BOX {
+                b.big.push(i);
+                b.is_big[i as usize] = true;
+            } else {
+                b.small.push(i);
+            }
         }
-        let level = GridLevel::build(boxes, &small, cell, &mut self.scratch);
-        let mut keys = Vec::new();
-        level.self_pairs(boxes, &mut keys);
-        oversize_pairs(boxes, &big, &live, &is_big, &mut keys);
-        self.cache.replace(&mut self.store, keys, false)
+        self.level.rebuild(boxes, &b.small, cell, &mut self.scratch);
+        self.level.self_pairs(boxes, &mut b.keys);
+        oversize_pairs(boxes, &b.big, &b.live, &b.is_big, &mut b.keys);
+        self.cache
+            .replace_reusing(&mut self.store, &mut b.keys, false)
     }
 
     impl_common_broadphase!();

@@ -8,7 +8,7 @@
 //! occupied coarser levels ([`GridLevel::query`]); each pair is reported once, by its smaller
 //! box, in the lowest common cell.
 
-use super::grid::{oversize_pairs, CellEntry, GridLevel};
+use super::grid::{oversize_pairs, CellEntry, GridBuffers, GridLevel};
 use super::impl_rebuilt_proxies;
 use super::{impl_common_broadphase, BroadPhase, PairCache, PairChanges, ProxyStore};
 use crate::math::Real;
@@ -17,12 +17,33 @@ use crate::math::Real;
 const MAX_LEVELS: usize = 32;
 
 /// The hierarchical grid broadphase (see the module docs).
-#[derive(Debug, Clone, Default)]
+#[derive(Debug, Clone)]
 pub struct HierarchicalGrid {
     store: ProxyStore,
     cache: PairCache,
     scratch: Vec<CellEntry>,
     levels_used: usize,
+    /// Buffers reused by every update (no allocation in the steady state): the boxes of
+    /// each level, the levels (rebuilt in place) and the occupied level indices.
+    bufs: GridBuffers,
+    by_level: Vec<Vec<u32>>,
+    levels: Vec<GridLevel>,
+    used: Vec<usize>,
+}
+
+impl Default for HierarchicalGrid {
+    fn default() -> Self {
+        HierarchicalGrid {
+            store: ProxyStore::default(),
+            cache: PairCache::default(),
+            scratch: Vec::new(),
+            levels_used: 0,
+            bufs: GridBuffers::default(),
+            by_level: vec![Vec::new(); MAX_LEVELS],
+            levels: vec![GridLevel::default(); MAX_LEVELS],
+            used: Vec::with_capacity(MAX_LEVELS),
+        }
+    }
 }
 
 impl HierarchicalGrid {
@@ -43,10 +64,12 @@ impl BroadPhase for HierarchicalGrid {
     }
 
     fn update_pairs(&mut self) -> &PairChanges {
-        let live = self.store.live_indices();
+        let b = &mut self.bufs;
+        self.store.live_indices_into(&mut b.live);
         let boxes = self.store.aabbs();
         let ext = |i: u32| boxes[i as usize].extents().max_element();
-        let smallest = live
+        let smallest = b
+            .live
             .iter()
             .map(|&i| ext(i))
             .filter(|&e| e > 0.0)
@@ -55,14 +78,15 @@ impl BroadPhase for HierarchicalGrid {
         // (e.g. planes' huge boxes) go to the oversize list.
         let base = if smallest.is_finite() { smallest } else { 1.0 };
         let top = base * (2.0 as Real).powi(MAX_LEVELS as i32 - 1);
-        let mut by_level: Vec<Vec<u32>> = vec![Vec::new(); MAX_LEVELS];
-        let mut big = Vec::new();
-        let mut is_big = vec![false; self.store.capacity()];
-        for &i in &live {
+        b.reset(self.store.capacity());
+        for l in &mut self.by_level {
+            l.clear();
+        }
+        for &i in &b.live {
             let e = ext(i);
             if e > top || !top.is_finite() {
-                big.push(i);
-                is_big[i as usize] = true;
+                b.big.push(i);
+                b.is_big[i as usize] = true;
                 continue;
             }
             let mut l = 0;
@@ -71,27 +95,28 @@ impl BroadPhase for HierarchicalGrid {
                 size *= 2.0;
                 l += 1;
             }
-            by_level[l].push(i);
+            self.by_level[l].push(i);
         }
-        let mut levels: Vec<(usize, GridLevel)> = Vec::new();
-        for (l, ids) in by_level.iter().enumerate() {
+        self.used.clear();
+        for (l, ids) in self.by_level.iter().enumerate() {
             if !ids.is_empty() {
                 let size = base * (2.0 as Real).powi(l as i32);
-                levels.push((l, GridLevel::build(boxes, ids, size, &mut self.scratch)));
+                self.levels[l].rebuild(boxes, ids, size, &mut self.scratch);
+                self.used.push(l);
             }
         }
-        self.levels_used = levels.len();
-        let mut keys = Vec::new();
-        for (n, (l, level)) in levels.iter().enumerate() {
-            level.self_pairs(boxes, &mut keys);
-            for &a in &by_level[*l] {
-                for (_, coarser) in &levels[n + 1..] {
-                    coarser.query(boxes, a, &mut keys);
+        self.levels_used = self.used.len();
+        for (n, &l) in self.used.iter().enumerate() {
+            self.levels[l].self_pairs(boxes, &mut b.keys);
+            for &a in &self.by_level[l] {
+                for &c in &self.used[n + 1..] {
+                    self.levels[c].query(boxes, a, &mut b.keys);
                 }
             }
         }
-        oversize_pairs(boxes, &big, &live, &is_big, &mut keys);
-        self.cache.replace(&mut self.store, keys, false)
+        oversize_pairs(boxes, &b.big, &b.live, &b.is_big, &mut b.keys);
+        self.cache
+            .replace_reusing(&mut self.store, &mut b.keys, false)
     }
 
     impl_common_broadphase!();

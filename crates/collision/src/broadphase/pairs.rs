@@ -34,6 +34,8 @@ pub struct PairCache {
     keys: Vec<u64>,
     changes: PairChanges,
     user_filter: Option<UserFilter>,
+    /// Radix-sort scratch of [`PairCache::replace_reusing`].
+    scratch: Vec<u64>,
 }
 
 impl std::fmt::Debug for PairCache {
@@ -92,6 +94,29 @@ impl PairCache {
             self.accepts(store, a, b)
         });
         self.diff(store, keys);
+        store.end_frame();
+        &self.changes
+    }
+
+    /// [`PairCache::replace`] without allocating in the steady state: `keys` is sorted (with
+    /// the cache's scratch) and filtered in place, swapped in as the current pairs, and
+    /// receives the previous pair array for the caller to reuse as its next key buffer.
+    pub fn replace_reusing(
+        &mut self,
+        store: &mut ProxyStore,
+        keys: &mut Vec<u64>,
+        sorted: bool,
+    ) -> &PairChanges {
+        if !sorted {
+            super::radix::par_sort_u64_with(keys, &mut self.scratch);
+        }
+        debug_assert!(keys.windows(2).all(|w| w[0] < w[1]), "pairs sorted, unique");
+        keys.retain(|&k| {
+            let (a, b) = unpack_pair(k);
+            self.accepts(store, a, b)
+        });
+        std::mem::swap(&mut self.keys, keys);
+        Self::diff_into(&mut self.changes, store, keys, &self.keys);
         store.end_frame();
         &self.changes
     }

@@ -165,4 +165,10 @@ impl ProxyStore {
             .filter(|&i| self.alive[i as usize])
             .collect()
     }
+
+    /// [`ProxyStore::live_indices`] into a reused buffer (cleared first).
+    pub fn live_indices_into(&self, out: &mut Vec<u32>) {
+        out.clear();
+        out.extend((0..self.alive.len() as u32).filter(|&i| self.alive[i as usize]));
+    }
 }

@@ -7,6 +7,8 @@
 
 const BITS: u32 = 11;
 const BUCKETS: usize = 1 << BITS;
+/// Digits of a 64-bit key.
+const PASSES: usize = 64usize.div_ceil(BITS as usize);
 
 /// Sorts `items` by `key(item)` ascending with a stable LSD radix sort (11-bit digits; digits
 /// on which all keys agree are skipped). `scratch` is reused storage.
@@ -20,9 +22,9 @@ pub fn radix_sort_by_key<T: Copy, K: Fn(&T) -> u64>(
         items.sort_by_key(|t| key(t));
         return;
     }
-    // One pass over the data builds every digit's histogram.
-    let passes = 64usize.div_ceil(BITS as usize);
-    let mut hist = vec![[0u32; BUCKETS]; passes];
+    // One pass over the data builds every digit's histogram (48 KB on the stack rather
+    // than the heap: the grids sort at every update, and the steady state allocates nothing).
+    let mut hist = [[0u32; BUCKETS]; PASSES];
     for t in items.iter() {
         let k = key(t);
         for (p, h) in hist.iter_mut().enumerate() {
@@ -62,6 +64,16 @@ pub fn radix_sort_by_key<T: Copy, K: Fn(&T) -> u64>(
 pub fn radix_sort_u64(keys: &mut Vec<u64>) {
     let mut scratch = Vec::new();
     radix_sort_by_key(keys, &mut scratch, |&k| k);
+}
+
+/// [`par_sort_u64`] with reused scratch storage: up to `2 × PAR_CHUNK` keys are sorted on
+/// this thread without allocating once `scratch` has grown; more take the parallel path.
+pub fn par_sort_u64_with(keys: &mut Vec<u64>, scratch: &mut Vec<u64>) {
+    if keys.len() <= 2 * PAR_CHUNK {
+        radix_sort_by_key(keys, scratch, |&k| k);
+    } else {
+        par_sort_u64(keys);
+    }
 }
 
 /// Chunk size of the parallel sort: fixed, so the work split (and the result) does not
