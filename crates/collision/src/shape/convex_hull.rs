@@ -314,6 +314,15 @@ impl ConvexHull {
         support_index(&self.lanes, dir)
     }
 
+    /// The box of the vertices rotated by `rotation` (see [`hull_lanes::rotated_bounds`]):
+    /// the hull's world box less the translation.
+    ///
+    /// [`hull_lanes::rotated_bounds`]: super::hull_lanes::rotated_bounds
+    pub(crate) fn rotated_bounds(&self, rotation: crate::math::Quat) -> (Vec3, Vec3) {
+        let m = crate::math::Mat3::from_quat(rotation);
+        super::hull_lanes::rotated_bounds(&self.lanes, m.x_axis, m.y_axis, m.z_axis)
+    }
+
     /// A triangulation of the faces (fans), counter-clockwise from outside.
     pub fn triangles(&self) -> &[[u32; 3]] {
         &self.triangles
