@@ -46,6 +46,29 @@ def test_box_resting_on_box_gives_four_corner_points() -> None:
     assert m.distance.min() == pytest.approx(c.distance, abs=10 * TOL)
 
 
+def test_capsule_lying_on_box_gives_two_analytic_points() -> None:
+    # A capsule (radius 0.25, half height 0.6) along X, 1 cm into the top face of a box:
+    # the closed-form capsule-box manifold clips its segment to the face, one point per end.
+    ground = carom.Box([1.0, 0.5, 1.0])
+    cap = carom.Capsule(0.25, 0.6)
+    s = np.sqrt(0.5)
+    along_x = [0.0, 0.0, s, s]  # 90 degrees about Z: the capsule's Y axis onto -X
+    for a, pa, b, pb, box_first in [
+        (ground, pose([0, 0, 0]), cap, pose([0.1, 0.74, 0.2], along_x), True),
+        (cap, pose([0.1, 0.74, 0.2], along_x), ground, pose([0, 0, 0]), False),
+    ]:
+        m = carom.contact_manifold(a, pa, b, pb)
+        check_points(m)
+        assert len(m) == 2
+        np.testing.assert_allclose(m.depth, 0.01, atol=10 * TOL)
+        on_box = m.point_a if box_first else m.point_b
+        np.testing.assert_allclose(sorted(on_box[:, 0]), [-0.5, 0.7], atol=10 * TOL)
+        np.testing.assert_allclose(on_box[:, 1], 0.5, atol=10 * TOL)
+        c = carom.contact(a, pa, b, pb)
+        assert c is not None
+        assert c.distance == pytest.approx(-0.01, abs=10 * TOL)
+
+
 def random_shape(rng: np.random.Generator, kind: int) -> carom.Shape:
     if kind == 0:
         return carom.Box(rng.uniform(0.2, 0.6, 3))

@@ -110,10 +110,9 @@ fn edge_witness_off_triangle_far_2() {
 }
 
 /// Found by `bug_hunt_triangle_face_on_far` (f64): dispatcher, box against triangle: overlap 0.00020737086481403821 but no contact.
-/// Open defect, ignored: the triangle–box path reports no contact at an overlap of 0.2 mm
-/// (just above the f64 oracle's tolerance; a nearly parallel pair 1 km out); present before
-/// this round's fixes (it fails with the old clip-miss tolerance too). Root cause not found.
-#[ignore]
+/// The triangle–box SAT measured an edge axis's gap with the triangle's edge alone, while
+/// within its Gauss-map tolerance the opposite vertex stuck out 0.2 mm further along the
+/// nearly parallel axis: a false gap, no contact. Now the true extent is used.
 #[test]
 #[allow(clippy::excessive_precision)] // f64 values, rounded in the f32 build
 fn lost_contact_triangle_box_1() {
@@ -152,10 +151,9 @@ fn lost_contact_triangle_box_1() {
     check_pair_tilted(&b, &t, &pr, tilt).unwrap();
 }
 /// Found by `bug_hunt_triangle_face_on_far` (f64): dispatcher, triangle against box: overlap 0.00022456567005946226 but no contact.
-/// Open defect, ignored: the triangle–box path reports no contact at an overlap of 0.2 mm
-/// (just above the f64 oracle's tolerance; a nearly parallel pair 1 km out); present before
-/// this round's fixes (it fails with the old clip-miss tolerance too). Root cause not found.
-#[ignore]
+/// The triangle–box SAT measured an edge axis's gap with the triangle's edge alone, while
+/// within its Gauss-map tolerance the opposite vertex stuck out 0.2 mm further along the
+/// nearly parallel axis: a false gap, no contact. Now the true extent is used.
 #[test]
 #[allow(clippy::excessive_precision)] // f64 values, rounded in the f32 build
 fn lost_contact_triangle_box_2() {

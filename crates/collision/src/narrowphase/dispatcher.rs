@@ -5,6 +5,7 @@
 //! [`Dispatcher::check_pair`] (called when an object is added), never silently skipped.
 
 use super::contact::{ContactList, ContactPoint, FeatureId, NO_FEATURE};
+use super::contact_capsule_cuboid::capsule_cuboid_manifold;
 use super::contact_cuboid_cuboid::cuboid_cuboid_manifold_into;
 use super::convex::{
     capsule_capsule_manifold, capsule_polyhedron_manifold, perturbed_contacts,
@@ -124,6 +125,10 @@ pub fn convex_convex_into(
         }
         (C::Capsule(x), C::Capsule(y)) => {
             out.extend(capsule_capsule_manifold(x, y, pose_ab, pred));
+            true
+        }
+        (C::Capsule(x), C::Cuboid(y)) => {
+            out.extend(capsule_cuboid_manifold(x, y, pose_ab, pred));
             true
         }
         (C::Capsule(x), _) if as_polyhedron(b).is_some() => {

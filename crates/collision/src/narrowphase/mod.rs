@@ -4,6 +4,7 @@
 //! - [`contact`]: the contact point; [`manifold`]: the persistent manifold;
 //! - [`pipeline`]: the [`NarrowPhase`] stage of the collision world (events, sensors);
 //! - [`contact_cuboid_cuboid`]: box–box, settled by the boxes' own separating-axis test;
+//!   [`contact_capsule_cuboid`]: capsule–box, segment–box closest points and face clipping;
 //! - [`polyhedron`]: SAT with Gauss-map pruning and face clipping for boxes, hulls and
 //!   triangles, and plane–polyhedron; [`convex`]: analytic manifolds for round shapes and
 //!   multi-point by perturbation; [`triangle_cuboid`]: the triangle–box special case of the
@@ -17,6 +18,7 @@ pub use contact::{ContactList, ContactPoint, FeatureId, NO_FEATURE};
 pub use manifold::{
     ContactManifold, ManifoldConfig, COHERENCE_ANGLE, COHERENCE_DISTANCE, MAX_MANIFOLD_POINTS,
 };
+pub mod contact_capsule_cuboid;
 pub mod contact_cuboid_cuboid;
 pub mod convex;
 pub mod dispatcher;

@@ -95,12 +95,17 @@ pub fn triangle_cuboid_manifold_into(
             let r = radius(c);
             let (pe, po) = (c.dot(v[p]), c.dot(v[o]));
             let eps = 1.0e-4 * dj.length();
+            // The triangle's true extent along c: within `eps` the edge counts as its
+            // supporting feature, but the gap must not use the edge alone (the opposite
+            // vertex may stick out by up to `eps`, which reported a 0.2 mm overlap of a
+            // nearly parallel pair as a gap, and lost the contact).
+            let (hi, lo) = (pe.max(po), pe.min(po));
             // +c: the edge is the triangle's maximum along c; -c: its minimum.
             let (s, u) = if pe >= po - eps {
-                let s1 = -r - pe;
+                let s1 = -r - hi;
                 if pe <= po + eps {
                     // The whole triangle is flat along c (c is the normal): both sides.
-                    let s2 = -r + pe;
+                    let s2 = -r + lo;
                     if s2 > s1 {
                         (s2, -c)
                     } else {
@@ -110,7 +115,7 @@ pub fn triangle_cuboid_manifold_into(
                     (s1, c)
                 }
             } else {
-                (-r + pe, -c)
+                (-r + lo, -c)
             };
             if s > prediction {
                 return;

@@ -8,6 +8,7 @@
 //! `ra + rb`, so the depth is the cores' depth plus `ra + rb`, still exact). If the cores'
 //! difference is flat (segment against segment), EPA runs on the full shapes.
 
+use super::contact_capsule_cuboid::contact_capsule_cuboid;
 use super::contact_cuboid_cuboid::contact_cuboid_cuboid;
 use super::contact_round::{
     contact_capsule_capsule, contact_sphere_capsule, contact_sphere_cuboid, contact_sphere_sphere,
@@ -34,7 +35,7 @@ pub fn swap_contact(
 
 /// Contact of two convex shapes in A's frame, or `None` when they are further apart than
 /// `prediction`. Dispatches to an exact special case when one exists (sphere–sphere,
-/// sphere–box, sphere–capsule, sphere–triangle, capsule–capsule, box–box) and to
+/// sphere–box, sphere–capsule, sphere–triangle, capsule–capsule, capsule–box, box–box) and to
 /// [`contact_gjk_epa`] otherwise.
 pub fn contact_convex(
     a: ConvexRef<'_>,
@@ -58,6 +59,10 @@ pub fn contact_convex(
             swap_contact(pose_ab, |p| contact_sphere_triangle(b, a, p, prediction))
         }
         (C::Capsule(a), C::Capsule(b)) => contact_capsule_capsule(a, b, pose_ab, prediction),
+        (C::Capsule(a), C::Cuboid(b)) => contact_capsule_cuboid(a, b, pose_ab, prediction),
+        (C::Cuboid(a), C::Capsule(b)) => {
+            swap_contact(pose_ab, |p| contact_capsule_cuboid(b, a, p, prediction))
+        }
         (C::Cuboid(a), C::Cuboid(b)) => contact_cuboid_cuboid(a, b, pose_ab, prediction),
         _ => contact_gjk_epa(a, b, pose_ab, prediction),
     }

@@ -58,9 +58,52 @@ pub fn contact_cuboid_cuboid(
             depth,
             normal,
             axis,
-        } => (-depth <= prediction)
-            .then(|| cuboid_cuboid_witness(a, b, pose_ab, depth, normal, axis)),
+        } => (-depth <= prediction).then(|| {
+            let c = cuboid_cuboid_witness(a, b, pose_ab, depth, normal, axis);
+            if matches!(axis, Axis::Edge(..)) && !edge_witness_realised(&c, a, b) {
+                // Coplanar faces make the cross product of two in-plane edges the face
+                // normal, which can win by round-off although those edges do not meet
+                // (their closest points were 0.15 m apart): the best face axis instead.
+                let (depth, normal, axis) = best_face_axis(a, b, pose_ab);
+                cuboid_cuboid_witness(a, b, pose_ab, depth, normal, axis)
+            } else {
+                c
+            }
+        }),
     }
+}
+
+/// True when the edge witnesses of `c` are `c.distance` apart along `c.normal`, up to
+/// round-off on the boxes' size (the closest points of the two supporting edges realise the
+/// overlap only when the edges do meet there).
+fn edge_witness_realised(c: &Contact, a: &Cuboid, b: &Cuboid) -> bool {
+    let scale = a.half_extents().max_element() + b.half_extents().max_element();
+    let off = (c.point_b - c.point_a - c.normal * c.distance).length();
+    off <= 1.0e3 * EPSILON * scale + 1.0e-3 * c.distance.abs()
+}
+
+/// The face axis (of A or B) of least overlap of two overlapping boxes, as
+/// `(overlap, normal from A towards B, axis)`, with the projections of
+/// [`cuboid_cuboid_sat`].
+fn best_face_axis(a: &Cuboid, b: &Cuboid, pose_ab: &Isometry) -> (Real, Vec3, Axis) {
+    let (ha, hb) = (a.half_extents(), b.half_extents());
+    let rot = pose_ab.rotation_matrix();
+    let t = pose_ab.translation;
+    let bx = [rot.x_axis, rot.y_axis, rot.z_axis];
+    let mut best = (Real::INFINITY, Vec3::X, Axis::FaceA(0));
+    for (axis, kind) in (0..3)
+        .map(|i| (Vec3::AXES[i], Axis::FaceA(i)))
+        .chain((0..3).map(|j| (bx[j], Axis::FaceB(j))))
+    {
+        let ra = ha.x * axis.x.abs() + ha.y * axis.y.abs() + ha.z * axis.z.abs();
+        let rb = (0..3).map(|j| hb[j] * axis.dot(bx[j]).abs()).sum::<Real>();
+        let dist = axis.dot(t);
+        let overlap = ra + rb - dist.abs();
+        if overlap < best.0 {
+            best = (overlap, if dist < 0.0 { -axis } else { axis }, kind);
+        }
+    }
+    best
 }
 
 /// The separating-axis test of [`contact_cuboid_cuboid`] without the witness points of an

@@ -36,6 +36,7 @@ pub mod support_adapters;
 
 pub use result::{Contact, PointProjection, RayHit, ShapeCastHit};
 pub mod closest_points;
+pub mod contact_capsule_cuboid;
 pub mod contact_convex;
 pub mod contact_cuboid_cuboid;
 pub mod contact_round;
