@@ -203,3 +203,47 @@ fn non_finite_or_touching_pairs_get_no_certificate() {
     m.clear();
     assert!(m.apart.is_none());
 }
+
+/// The coherence test's cheap bound must see small rotations in f32 too: a box resting on a
+/// box, turned by 4e-4 rad about the vertical (its corners move by about 3e-4, three times
+/// `COHERENCE_DISTANCE`), is generated again. Before, `sqrt(1 - (q·q0)²)` rounded to 0 in
+/// f32 below about 5e-4 rad and the stale points were kept.
+#[test]
+fn coherence_sees_small_rotations() {
+    use carom_collision::narrowphase::COHERENCE_DISTANCE;
+    let d = Dispatcher::new(ManifoldConfig::default());
+    let a = Shape::Cuboid(Cuboid::new(Vec3::new(5.0, 0.5, 5.0)).unwrap());
+    let b = Shape::Cuboid(Cuboid::new(Vec3::splat(0.5)).unwrap());
+    for origin in [Vec3::ZERO, Vec3::new(300.0, 0.0, -200.0)] {
+        let pose_a = Isometry::from_translation(origin);
+        let at = |angle: Real| {
+            Isometry::new(
+                origin + Vec3::new(0.0, 0.999, 0.0),
+                Quat::from_rotation_y(0.3 + angle),
+            )
+        };
+        let mut m = ContactManifold::new();
+        d.update_manifold(&a, &pose_a, &b, &at(0.0), &mut m)
+            .unwrap();
+        assert_eq!(m.len(), 4);
+        let before = m.generated_at;
+        // A rotation whose corner motion stays under the tolerance keeps the points...
+        let tiny = 0.5 * COHERENCE_DISTANCE / 0.75;
+        d.update_manifold(&a, &pose_a, &b, &at(tiny), &mut m)
+            .unwrap();
+        assert_eq!(m.generated_at, before, "kept at {tiny} rad");
+        // ... one that moves the corners by three times the tolerance regenerates them.
+        d.update_manifold(&a, &pose_a, &b, &at(4.0e-4), &mut m)
+            .unwrap();
+        assert_ne!(m.generated_at, before, "regenerated at 4e-4 rad");
+        let fresh = {
+            let mut f = ContactManifold::new();
+            d.update_manifold(&a, &pose_a, &b, &at(4.0e-4), &mut f)
+                .unwrap();
+            f
+        };
+        for (p, q) in m.points.iter().zip(&fresh.points) {
+            assert!((p.point_b - q.point_b).length() <= COHERENCE_DISTANCE);
+        }
+    }
+}

@@ -151,8 +151,16 @@ impl ContactManifold {
         }
         // Cheap sufficient test first: a point x moves by at most |Δt| + 2 sin(θ/2) |x|
         // (θ the relative rotation angle), so no per-point transform is needed while the
-        // pose has (nearly) not changed, the common case of resting contacts.
-        let sin_half = (1.0 - c * c).max(0.0).sqrt();
+        // pose has (nearly) not changed, the common case of resting contacts. sin(θ/2) is
+        // bounded by the quaternions' chord |q - q0| = 2 sin(θ/4) (see `Separation::holds`):
+        // `sqrt(1 - c²)` rounded to 0 in f32 below about 5e-4 rad, and points that had moved
+        // three times the tolerance were kept.
+        let q0 = if p0.rotation.dot(pose_ab.rotation) < 0.0 {
+            -p0.rotation
+        } else {
+            p0.rotation
+        };
+        let sin_half = (pose_ab.rotation - q0).length();
         let dt = (pose_ab.translation - p0.translation).length();
         let reach = self
             .points
