@@ -17,10 +17,13 @@
 //! pairs whose segments do not realise the axis separation.
 
 use super::contact::{ContactList, FeatureId};
+use super::manifold::Separation;
 use super::polyhedron::{polyhedron_manifold_guided, Polyhedron, EPA_FEATURE};
 use super::polyhedron_guided::witness_realises_depth;
 use crate::math::{Isometry, Real, Vec3};
-use crate::query::contact_cuboid_cuboid::{cuboid_cuboid_axis, cuboid_cuboid_witness, Axis};
+use crate::query::contact_cuboid_cuboid::{
+    cuboid_cuboid_axis_or_separation, cuboid_cuboid_witness, Axis,
+};
 use crate::query::Contact;
 use crate::shape::{ConvexRef, Cuboid};
 use smallvec::SmallVec;
@@ -40,8 +43,31 @@ pub fn cuboid_cuboid_manifold_into(
     prediction: Real,
     out: &mut ContactList,
 ) {
-    let Some((overlap, n, axis)) = cuboid_cuboid_axis(x, y, pose_ab, prediction) else {
-        return;
+    // The certificate of an apart pair is for the persistent manifold only.
+    let _ = cuboid_cuboid_manifold_or_separation(x, y, pose_ab, prediction, out);
+}
+
+/// [`cuboid_cuboid_manifold_into`], returning for a pair that one axis separates by more
+/// than `prediction` (nothing appended) that axis as a [`Separation`] certificate, which
+/// the persistent manifold keeps to skip the pair while the relative motion cannot close
+/// the gap; `None` otherwise (points appended, or a pair within `prediction` that has none).
+pub fn cuboid_cuboid_manifold_or_separation(
+    x: &Cuboid,
+    y: &Cuboid,
+    pose_ab: &Isometry,
+    prediction: Real,
+    out: &mut ContactList,
+) -> Option<Separation> {
+    let (overlap, n, axis) = match cuboid_cuboid_axis_or_separation(x, y, pose_ab, prediction) {
+        Ok(found) => found,
+        Err((distance, axis)) => {
+            return distance.is_finite().then_some(Separation {
+                pose_ab: *pose_ab,
+                axis,
+                distance,
+                reach: y.half_extents().length(),
+            })
+        }
     };
     let (ha, hb) = (x.half_extents(), y.half_extents());
     let start = out.len();
@@ -84,6 +110,7 @@ pub fn cuboid_cuboid_manifold_into(
             out,
         );
     }
+    None
 }
 
 /// Feature id base of A's reference face `fa` (the layout of the polyhedron clipper's ids).

@@ -6,7 +6,9 @@
 
 use super::contact::{ContactList, ContactPoint, FeatureId, NO_FEATURE};
 use super::contact_capsule_cuboid::capsule_cuboid_manifold;
-use super::contact_cuboid_cuboid::cuboid_cuboid_manifold_into;
+use super::contact_cuboid_cuboid::{
+    cuboid_cuboid_manifold_into, cuboid_cuboid_manifold_or_separation,
+};
 use super::convex::{
     capsule_capsule_manifold, capsule_polyhedron_manifold, perturbed_contacts,
     plane_capsule_manifold,
@@ -501,7 +503,15 @@ impl Dispatcher {
         let before = manifold.len();
         manifold.refresh(pose_a, pose_b, cfg.breaking_threshold);
         let pose_ab = pose_a.inv_mul(pose_b);
-        if manifold.len() == before && manifold.is_coherent(&pose_ab) {
+        if before == 0 {
+            // An apart pair whose separating axis still proves the gap: nothing to generate.
+            if manifold
+                .apart
+                .is_some_and(|s| s.holds(&pose_ab, cfg.prediction))
+            {
+                return Ok(());
+            }
+        } else if manifold.len() == before && manifold.is_coherent(&pose_ab) {
             return Ok(());
         }
         SCRATCH.with(|cell| {
@@ -514,8 +524,22 @@ impl Dispatcher {
             };
             contacts.clear();
             pts.clear();
-            let full =
-                self.generate_into_with(a, b, &pose_ab, cfg, manifold.is_empty(), contacts)?;
+            manifold.apart = None;
+            let full = match (a, b) {
+                // Box–box directly (the built-in table's choice), keeping the separating axis
+                // of an apart pair as the manifold's certificate.
+                (Shape::Cuboid(x), Shape::Cuboid(y)) if self.user.is_empty() => {
+                    manifold.apart = cuboid_cuboid_manifold_or_separation(
+                        x,
+                        y,
+                        &pose_ab,
+                        cfg.prediction,
+                        contacts,
+                    );
+                    true
+                }
+                _ => self.generate_into_with(a, b, &pose_ab, cfg, manifold.is_empty(), contacts)?,
+            };
             pts.extend(
                 contacts
                     .iter()

@@ -53,6 +53,54 @@ pub struct ContactManifold {
     /// caching and parry's `try_update_contacts`).
     #[serde(default)]
     pub generated_at: Option<Isometry>,
+    /// For an empty manifold: a certificate that the shapes were apart by more than the
+    /// prediction at the last generation, or `None`. While [`Separation::holds`] for the
+    /// current relative pose, generating again cannot find a point, and the update skips it.
+    #[serde(default)]
+    pub apart: Option<Separation>,
+}
+
+/// A separating axis of an apart pair and what it proves (Bullet's
+/// `btConvexSeparatingDistanceUtil`, which bounds how fast a separating distance can shrink
+/// under the bodies' motion; Box2D's and Rapier's broadphases use the same conservative
+/// bound for their fat boxes).
+///
+/// At the relative pose `pose_ab` (B in A's frame), every point of B was at least `distance`
+/// beyond A along the unit `axis` (in A's frame, from A towards B), and every point of B lies
+/// within `reach` of B's origin. After B moves to a relative pose whose translation differs
+/// by `Δt` and whose rotation differs by an angle `θ`, each point of B has moved by at most
+/// `|Δt| + 2 sin(θ/2) reach` (A does not move in its own frame), so the separation along the
+/// same axis is at least `distance` minus that: a lower bound of the shapes' distance.
+/// (The test bounds `2 sin(θ/2)` by twice the quaternions' chord, which stays accurate for
+/// tiny angles in f32.)
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Separation {
+    /// The relative pose (B in A's frame) at which the separation was measured.
+    pub pose_ab: Isometry,
+    /// Unit separating axis in A's frame, pointing from A towards B.
+    pub axis: Vec3,
+    /// Separation of the shapes along `axis` at `pose_ab` (a lower bound of their distance).
+    pub distance: Real,
+    /// Radius about B's origin of a ball holding B.
+    pub reach: Real,
+}
+
+impl Separation {
+    /// True when, at the relative pose `pose_ab`, the shapes are still certainly more than
+    /// `prediction` apart (see the type's docs). False for non-finite values.
+    pub fn holds(&self, pose_ab: &Isometry, prediction: Real) -> bool {
+        let p0 = &self.pose_ab;
+        // For unit quaternions at an angle θ, |q - q0| = 2 sin(θ/4) (q0's sign chosen to
+        // match), so 2 sin(θ/2) = 4 sin(θ/4) cos(θ/4) <= 2 |q - q0|. Not sqrt(1 - (q·q0)²):
+        // in f32, q·q0 rounds to 1 for angles under about 5e-4 rad.
+        let (q0, q) = (p0.rotation, pose_ab.rotation);
+        let q0 = if q0.dot(q) < 0.0 { -q0 } else { q0 };
+        let chord = (q - q0).length();
+        let moved = (pose_ab.translation - p0.translation).length() + 2.0 * chord * self.reach;
+        // Round-off of the separation, measured at p0: relative to the sizes involved.
+        let slack = 1.0e-5 * (p0.translation.length() + self.reach);
+        self.distance - moved - slack > prediction
+    }
 }
 
 /// Relative rotation (radians) under which a manifold's points are reused unchanged.
@@ -82,6 +130,7 @@ impl ContactManifold {
     pub fn clear(&mut self) {
         self.points.clear();
         self.generated_at = None;
+        self.apart = None;
     }
 
     /// True when the manifold holds a full manifold generated at a relative pose within
@@ -102,8 +151,16 @@ impl ContactManifold {
         }
         // Cheap sufficient test first: a point x moves by at most |Δt| + 2 sin(θ/2) |x|
         // (θ the relative rotation angle), so no per-point transform is needed while the
-        // pose has (nearly) not changed, the common case of resting contacts.
-        let sin_half = (1.0 - c * c).max(0.0).sqrt();
+        // pose has (nearly) not changed, the common case of resting contacts. sin(θ/2) is
+        // bounded by the quaternions' chord |q - q0| = 2 sin(θ/4) (see `Separation::holds`):
+        // `sqrt(1 - c²)` rounded to 0 in f32 below about 5e-4 rad, and points that had moved
+        // three times the tolerance were kept.
+        let q0 = if p0.rotation.dot(pose_ab.rotation) < 0.0 {
+            -p0.rotation
+        } else {
+            p0.rotation
+        };
+        let sin_half = (pose_ab.rotation - q0).length();
         let dt = (pose_ab.translation - p0.translation).length();
         let reach = self
             .points

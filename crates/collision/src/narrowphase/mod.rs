@@ -16,7 +16,8 @@ pub mod manifold;
 
 pub use contact::{ContactList, ContactPoint, FeatureId, NO_FEATURE};
 pub use manifold::{
-    ContactManifold, ManifoldConfig, COHERENCE_ANGLE, COHERENCE_DISTANCE, MAX_MANIFOLD_POINTS,
+    ContactManifold, ManifoldConfig, Separation, COHERENCE_ANGLE, COHERENCE_DISTANCE,
+    MAX_MANIFOLD_POINTS,
 };
 pub mod contact_capsule_cuboid;
 pub mod contact_cuboid_cuboid;

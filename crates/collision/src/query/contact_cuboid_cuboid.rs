@@ -232,6 +232,20 @@ pub fn cuboid_cuboid_axis(
     pose_ab: &Isometry,
     prediction: Real,
 ) -> Option<(Real, Vec3, Axis)> {
+    cuboid_cuboid_axis_or_separation(a, b, pose_ab, prediction).ok()
+}
+
+/// [`cuboid_cuboid_axis`], telling why a pair was rejected: `Err((separation, axis))` with
+/// the first axis found to separate the boxes by more than `prediction` (unit, from A
+/// towards B in A's frame) and the separation along it (NaN for non-finite input). The
+/// persistent manifold keeps it as a certificate that the pair is apart
+/// ([`crate::narrowphase::manifold::Separation`]).
+pub fn cuboid_cuboid_axis_or_separation(
+    a: &Cuboid,
+    b: &Cuboid,
+    pose_ab: &Isometry,
+    prediction: Real,
+) -> Result<(Real, Vec3, Axis), (Real, Vec3)> {
     let ha = a.half_extents();
     let hb = b.half_extents();
     let rot = pose_ab.rotation_matrix();
@@ -239,9 +253,11 @@ pub fn cuboid_cuboid_axis(
     let bx = [rot.x_axis, rot.y_axis, rot.z_axis];
     let abs_b = [bx[0].abs(), bx[1].abs(), bx[2].abs()];
     let mut best = (Real::INFINITY, Vec3::ZERO, Axis::FaceA(0));
+    let mut apart = (Real::NAN, Vec3::ZERO);
     // False when `axis` separates the boxes by more than the prediction.
     let mut consider = |overlap: Real, dist: Real, axis: Vec3, kind: Axis| -> bool {
         if overlap < -prediction || overlap.is_nan() {
+            apart = (-overlap, if dist < 0.0 { -axis } else { axis });
             return false;
         }
         if overlap < best.0 {
@@ -255,7 +271,7 @@ pub fn cuboid_cuboid_axis(
         let mut e = Vec3::ZERO;
         e[i] = 1.0;
         if !consider(ha[i] + rb_faces[i] - t[i].abs(), t[i], e, Axis::FaceA(i)) {
-            return None;
+            return Err(apart);
         }
     }
     // B's faces and the edge pairs: B's projection summed over its three axes, as in
@@ -265,7 +281,7 @@ pub fn cuboid_cuboid_axis(
         let ra = ha.x * abs_b[j].x + ha.y * abs_b[j].y + ha.z * abs_b[j].z;
         let dist = axis.dot(t);
         if !consider(ra + rb_of(axis) - dist.abs(), dist, axis, Axis::FaceB(j)) {
-            return None;
+            return Err(apart);
         }
     }
     for i in 0..3 {
@@ -282,11 +298,11 @@ pub fn cuboid_cuboid_axis(
             let ra = ha.x * axis.x.abs() + ha.y * axis.y.abs() + ha.z * axis.z.abs();
             let dist = axis.dot(t);
             if !consider(ra + rb_of(axis) - dist.abs(), dist, axis, Axis::Edge(i, j)) {
-                return None;
+                return Err(apart);
             }
         }
     }
-    Some(best)
+    Ok(best)
 }
 
 /// The witness points of an overlap found by [`cuboid_cuboid_sat`].

@@ -5,7 +5,8 @@
 //! [`crate::pipeline`]) in a reused buffer, carrying the accumulated impulses in;
 //! `write_back` stores the solver's impulses into the same narrowphase points afterwards.
 //! Both walk the narrowphase's manifolds in pair order, so entry `k` of the buffer maps back
-//! by its rank `sources[k]` without any lookup table.
+//! by its rank `sources[k].0` without any lookup table; `sources[k].1` keeps the sign that
+//! maps the second tangent impulse, so the frame is computed once per manifold.
 
 use super::World;
 use crate::body::{mix_friction, mix_restitution, BodyType};
@@ -86,7 +87,7 @@ impl World {
                 let _ = m.push(q);
             }
             self.contacts.push(m);
-            self.sources.push(rank as u32);
+            self.sources.push((rank as u32, sign));
         }
     }
 
@@ -98,10 +99,10 @@ impl World {
             if k == sources.len() {
                 break;
             }
-            if sources[k] as usize != rank {
+            let (source, sign) = sources[k];
+            if source as usize != rank {
                 continue;
             }
-            let (_, _, sign) = frame(&pc.manifold);
             for (p, q) in pc.manifold.points.iter_mut().zip(contacts[k].points()) {
                 p.normal_impulse = q.normal_impulse;
                 p.tangent_impulse = [q.tangent_impulse[0], q.tangent_impulse[1] * sign];

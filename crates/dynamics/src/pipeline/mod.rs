@@ -109,8 +109,9 @@ pub struct World {
     resting: Vec<bool>,
     /// Solver contacts of the current step (reused buffer).
     contacts: Vec<ContactManifold>,
-    /// For each entry of `contacts`, its rank among the non-empty narrowphase manifolds.
-    sources: Vec<u32>,
+    /// For each entry of `contacts`, its rank among the non-empty narrowphase manifolds and
+    /// the sign that maps its second tangent impulse (see `contacts.rs`).
+    sources: Vec<(u32, Real)>,
     /// Body slot pairs (low, high) whose joint disables collisions (reused buffer).
     disabled: Vec<(u32, u32)>,
     /// Time not yet simulated by [`World::step_simulation`].

@@ -48,8 +48,9 @@ use std::sync::Arc;
 
 /// Tag at the start of every world snapshot.
 pub const SNAPSHOT_MAGIC: &[u8; 10] = b"CAROMWORLD";
-/// Version of the snapshot format written by [`World::to_bytes`].
-pub const SNAPSHOT_VERSION: u16 = 1;
+/// Version of the snapshot format written by [`World::to_bytes`] (2: manifolds keep their
+/// separation certificate, `ContactManifold::apart`).
+pub const SNAPSHOT_VERSION: u16 = 2;
 const HEADER_LEN: usize = 10 + 2 + 1 + 8;
 
 #[derive(Serialize, Deserialize)]
