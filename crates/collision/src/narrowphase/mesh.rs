@@ -11,7 +11,8 @@
 //! it may turn up to the dihedral angle.
 
 use super::contact::{ContactList, FeatureId};
-use super::polyhedron::{polyhedron_manifold_posed, Polyhedron, PosedPolyhedron};
+use super::mesh_hull::{triangle_hull_manifold, EdgeScratch};
+use super::polyhedron::{Polyhedron, PosedPolyhedron};
 use crate::math::Aabb;
 use crate::math::{Isometry, Real, Vec3};
 use crate::query::closest_points::closest_point_segment;
@@ -197,9 +198,9 @@ pub fn mesh_convex_contacts<M: ContactTriangles + ?Sized>(
 }
 
 /// Triangles A against convex hull B: [`mesh_convex_contacts`] with the triangle–hull
-/// separating-axis test of [`super::polyhedron`], the hull placed in the mesh's frame once
-/// (vertices, face planes, edge arcs) for all the triangles instead of once per triangle.
-/// The contacts are those of the per-triangle `convex_convex` path, bit for bit.
+/// separating-axis test of [`super::mesh_hull`], the hull placed in the mesh's frame once
+/// (vertices, face planes) for all the triangles instead of once per triangle. The contacts
+/// are those of the per-triangle `convex_convex` path, bit for bit.
 pub fn mesh_hull_contacts<M: ContactTriangles + ?Sized>(
     mesh: &M,
     hull: &ConvexHull,
@@ -209,10 +210,11 @@ pub fn mesh_hull_contacts<M: ContactTriangles + ?Sized>(
 ) {
     let pb = Polyhedron::from_hull(hull);
     let mut posed: Option<PosedPolyhedron> = None;
+    let mut scratch = EdgeScratch::default();
     let mut tri_contacts = |t: &Triangle, out: &mut ContactList| {
-        let posed = posed.get_or_insert_with(|| PosedPolyhedron::new(&pb, pose_ab, true));
+        let posed = posed.get_or_insert_with(|| PosedPolyhedron::new(&pb, pose_ab, false));
         let pa = Polyhedron::from_triangle(t);
-        polyhedron_manifold_posed(&pa, &pb, posed, pose_ab, prediction, out);
+        triangle_hull_manifold(&pa, &pb, posed, pose_ab, prediction, &mut scratch, out);
     };
     let b = ConvexRef::ConvexHull(hull);
     mesh_convex_contacts(mesh, b, pose_ab, prediction, &mut tri_contacts, out);
