@@ -96,6 +96,70 @@ pub fn convex_aabb(b: ConvexRef<'_>, pose_ab: &Isometry) -> crate::math::Aabb {
     crate::math::Aabb::new(min, max)
 }
 
+/// The closed-form extent of a sphere, capsule or box along any direction, for the plane
+/// cull of [`mesh_convex_contacts`]: a triangle whose plane the shape clears by more than the
+/// prediction (on either side) is farther than the prediction, so it is skipped before its
+/// contact test (the midphase's boxes let through triangles whose planes pass beside the
+/// shape, e.g. the neighbours of the one under a body on a slope). Bullet's
+/// `btConvexPlaneCollisionAlgorithm` and Box2D's `b2CollidePolygons` reject on the same
+/// face axis first. Other shapes have their own first face test (hulls) or none.
+#[derive(Debug, Clone, Copy)]
+struct PlaneSlab {
+    /// Centre (sphere, box) or first segment end (capsule) in the mesh frame.
+    p: Vec3,
+    /// Second segment end (capsule), else `p`.
+    q: Vec3,
+    /// Radius (sphere, capsule), 0 for a box.
+    r: Real,
+    /// The box's half extents along its axes `axes` (zero otherwise).
+    half: Vec3,
+    axes: [Vec3; 3],
+    /// Round-off margin added to the prediction (relative to the shape's position and size).
+    tol: Real,
+}
+
+impl PlaneSlab {
+    fn new(b: ConvexRef<'_>, pose_ab: &Isometry) -> Option<PlaneSlab> {
+        let c = pose_ab.translation;
+        let (p, q, r, half, axes) = match b {
+            ConvexRef::Sphere(s) => (c, c, s.radius(), Vec3::ZERO, [Vec3::ZERO; 3]),
+            ConvexRef::Capsule(k) => {
+                let (p, q) = k.segment();
+                let (p, q) = (pose_ab.transform_point(p), pose_ab.transform_point(q));
+                (p, q, k.radius(), Vec3::ZERO, [Vec3::ZERO; 3])
+            }
+            ConvexRef::Cuboid(x) => {
+                let m = pose_ab.rotation_matrix();
+                (c, c, 0.0, x.half_extents(), [m.x_axis, m.y_axis, m.z_axis])
+            }
+            _ => return None,
+        };
+        let size = r + half.x + half.y + half.z + (q - p).length();
+        let tol = 1.0e-4 * (1.0 + size + p.abs().max_element());
+        Some(PlaneSlab {
+            p,
+            q,
+            r,
+            half,
+            axes,
+            tol,
+        })
+    }
+
+    /// True when the shape lies entirely more than `prediction` (plus round-off) above or
+    /// below the plane `n · x = off` (`n` unit).
+    #[inline]
+    fn clear_of_plane(&self, n: Vec3, off: Real, prediction: Real) -> bool {
+        let ext = self.r
+            + self.half.x * n.dot(self.axes[0]).abs()
+            + self.half.y * n.dot(self.axes[1]).abs()
+            + self.half.z * n.dot(self.axes[2]).abs();
+        let (dp, dq) = (n.dot(self.p) - off, n.dot(self.q) - off);
+        let gap = prediction + self.tol + ext;
+        (dp > gap && dq > gap) || (dp < -gap && dq < -gap)
+    }
+}
+
 /// Mixes a triangle or child index into a feature id (deterministic).
 #[inline]
 pub fn mix_feature(index: u32, id: FeatureId) -> FeatureId {
@@ -172,10 +236,17 @@ pub fn mesh_convex_contacts<M: ContactTriangles + ?Sized>(
     let mut tris: SmallVec<[u32; 64]> = SmallVec::new();
     mesh.for_each_candidate(&aabb, &mut |t| tris.push(t));
     tris.sort_unstable();
+    let slab = PlaneSlab::new(b, pose_ab);
     for t in tris {
         let [p, q, r] = mesh.corners(t);
         let tri = Triangle { a: p, b: q, c: r };
-        if tri.normal().is_none() || !tri.vertices().iter().all(|v| v.is_finite()) {
+        let Some(n) = tri.normal() else {
+            continue;
+        };
+        if !tri.vertices().iter().all(|v| v.is_finite()) {
+            continue;
+        }
+        if slab.is_some_and(|s| s.clear_of_plane(n, n.dot(p), prediction)) {
             continue;
         }
         let start = out.len();
@@ -219,3 +290,7 @@ pub fn mesh_hull_contacts<M: ContactTriangles + ?Sized>(
     let b = ConvexRef::ConvexHull(hull);
     mesh_convex_contacts(mesh, b, pose_ab, prediction, &mut tri_contacts, out);
 }
+
+#[cfg(test)]
+#[path = "mesh_tests.rs"]
+mod tests;
