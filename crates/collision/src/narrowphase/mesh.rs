@@ -11,8 +11,8 @@
 //! it may turn up to the dihedral angle.
 
 use super::contact::{ContactList, FeatureId};
-use super::mesh_hull::{triangle_hull_manifold, EdgeScratch};
-use super::polyhedron::{Polyhedron, PosedPolyhedron};
+use super::mesh_hull::{posed_hull, triangle_hull_manifold, EdgeScratch};
+use super::polyhedron::Polyhedron;
 use crate::math::Aabb;
 use crate::math::{Isometry, Real, Vec3};
 use crate::query::closest_points::closest_point_segment;
@@ -231,10 +231,23 @@ pub fn mesh_convex_contacts<M: ContactTriangles + ?Sized>(
     out: &mut ContactList,
 ) {
     let aabb = convex_aabb(b, pose_ab).expanded(prediction.max(0.0));
+    contacts_in_box(mesh, b, pose_ab, prediction, &aabb, tri_contacts, out);
+}
+
+/// [`mesh_convex_contacts`] with B's box (mesh frame, expanded by the prediction) given.
+fn contacts_in_box<M: ContactTriangles + ?Sized>(
+    mesh: &M,
+    b: ConvexRef<'_>,
+    pose_ab: &Isometry,
+    prediction: Real,
+    aabb: &Aabb,
+    tri_contacts: &mut dyn FnMut(&Triangle, &mut ContactList),
+    out: &mut ContactList,
+) {
     // Triangles in index order, so a mesh and a heightfield with the same triangles give
     // the same sequence of points (and the same reduced manifold).
     let mut tris: SmallVec<[u32; 64]> = SmallVec::new();
-    mesh.for_each_candidate(&aabb, &mut |t| tris.push(t));
+    mesh.for_each_candidate(aabb, &mut |t| tris.push(t));
     tris.sort_unstable();
     let slab = PlaneSlab::new(b, pose_ab);
     for t in tris {
@@ -270,8 +283,10 @@ pub fn mesh_convex_contacts<M: ContactTriangles + ?Sized>(
 
 /// Triangles A against convex hull B: [`mesh_convex_contacts`] with the triangle–hull
 /// separating-axis test of [`super::mesh_hull`], the hull placed in the mesh's frame once
-/// (vertices, face planes) for all the triangles instead of once per triangle. The contacts
-/// are those of the per-triangle `convex_convex` path, bit for bit.
+/// (vertices, face planes; [`posed_hull`]) for all the triangles instead of once per
+/// triangle. Given the same placed hull the contacts are those of the per-triangle
+/// `convex_convex` path bit for bit; the placement by a rotation matrix rounds differently
+/// from the quaternion's, by a few ulps.
 pub fn mesh_hull_contacts<M: ContactTriangles + ?Sized>(
     mesh: &M,
     hull: &ConvexHull,
@@ -280,15 +295,23 @@ pub fn mesh_hull_contacts<M: ContactTriangles + ?Sized>(
     out: &mut ContactList,
 ) {
     let pb = Polyhedron::from_hull(hull);
-    let mut posed: Option<PosedPolyhedron> = None;
+    // The hull is placed once per pair; its placed vertices also give its box (cheaper
+    // than six support queries).
+    let posed = posed_hull(&pb, pose_ab);
+    let Some(&first) = posed.vertices.first() else {
+        return;
+    };
+    let (lo, hi) = posed.vertices[1..]
+        .iter()
+        .fold((first, first), |(lo, hi), v| (lo.min(*v), hi.max(*v)));
+    let aabb = Aabb::new(lo, hi).expanded(prediction.max(0.0));
     let mut scratch = EdgeScratch::default();
     let mut tri_contacts = |t: &Triangle, out: &mut ContactList| {
-        let posed = posed.get_or_insert_with(|| PosedPolyhedron::new(&pb, pose_ab, false));
         let pa = Polyhedron::from_triangle(t);
-        triangle_hull_manifold(&pa, &pb, posed, pose_ab, prediction, &mut scratch, out);
+        triangle_hull_manifold(&pa, &pb, &posed, pose_ab, prediction, &mut scratch, out);
     };
     let b = ConvexRef::ConvexHull(hull);
-    mesh_convex_contacts(mesh, b, pose_ab, prediction, &mut tri_contacts, out);
+    contacts_in_box(mesh, b, pose_ab, prediction, &aabb, &mut tri_contacts, out);
 }
 
 #[cfg(test)]

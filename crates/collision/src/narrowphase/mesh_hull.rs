@@ -26,7 +26,7 @@
 
 use super::contact::ContactList;
 use super::polyhedron::{manifold_from_sat, Polyhedron, PosedPolyhedron, PARALLEL_SIN};
-use super::polyhedron_sat::max_dot;
+use super::polyhedron_sat::{max_dot, Buf};
 use crate::math::{Isometry, Real, Vec3};
 use smallvec::SmallVec;
 
@@ -43,6 +43,29 @@ const PREFILTER_SIN: Real = 0.05;
 pub(crate) struct EdgeScratch {
     dots: SmallVec<[[Real; 3]; 64]>,
     crossing: SmallVec<[(u32, u8); 64]>,
+}
+
+/// Hull `b` placed in the mesh's frame by `pose_ab` for [`triangle_hull_manifold`]: its
+/// vertices, face normals and plane offsets (no edge arcs), rotated by the pose's matrix
+/// (9 products a vector instead of the quaternion's ~20; `PosedPolyhedron::new` rotates by
+/// the quaternion, so the two agree to round-off, not bit for bit).
+pub(crate) fn posed_hull(b: &Polyhedron, pose_ab: &Isometry) -> PosedPolyhedron {
+    let m = pose_ab.rotation_matrix();
+    let t = pose_ab.translation;
+    let vertices: Buf = b.vertices().iter().map(|v| m * *v + t).collect();
+    let normals: Buf = b.faces().iter().map(|f| m * f.normal).collect();
+    let offsets = b
+        .faces()
+        .iter()
+        .zip(&normals)
+        .map(|(f, n)| f.offset + n.dot(t))
+        .collect();
+    PosedPolyhedron {
+        vertices,
+        normals,
+        offsets,
+        arcs: SmallVec::new(),
+    }
 }
 
 /// Contacts of triangle A (`a`, a view built by [`Polyhedron::from_triangle`]) against hull
@@ -150,14 +173,16 @@ fn triangle_hull_edge_query(
         nb.iter()
             .map(|n| [n.dot(da[0]), n.dot(da[1]), n.dot(da[2])]),
     );
+    let dots = &dots[..];
     crossing.clear();
     for (j, fb) in b.edge_faces().iter().enumerate() {
         let (d0, d1) = (dots[fb[0] as usize], dots[fb[1] as usize]);
+        // Branch-free: most hull edges cross none of the three circles.
         let mut bits = 0u8;
         for k in 0..3 {
             let (x, y) = (d0[k], d1[k]);
             let one_side = if masks {
-                (x > 0.0 && y > 0.0) || (x < 0.0 && y < 0.0)
+                ((x > 0.0) & (y > 0.0)) | ((x < 0.0) & (y < 0.0))
             } else {
                 x * y > 0.0
             };
@@ -167,17 +192,19 @@ fn triangle_hull_edge_query(
             crossing.push((j as u32, bits));
         }
     }
+    let crossing = &crossing[..];
+    let (edges_b, faces_b) = (b.edges(), b.edge_faces());
     let mut best = (Real::NEG_INFINITY, 0, 0, Vec3::ZERO);
     for (i, ea) in a.edges().iter().enumerate() {
         let pa = va[ea[0] as usize];
         let (da, o) = (da[i], o[i]);
         let oo = o.length_squared();
-        for &(j, bits) in crossing.iter() {
+        for &(j, bits) in crossing {
             if bits & (1 << i) == 0 {
                 continue;
             }
             let j = j as usize;
-            let (eb, fb) = (b.edges()[j], b.edge_faces()[j]);
+            let (eb, fb) = (edges_b[j], faces_b[j]);
             let (a0, a1) = (dots[fb[0] as usize][i], dots[fb[1] as usize][i]);
             let (n0, n1) = (nb[fb[0] as usize], nb[fb[1] as usize]);
             // The arc's crossing point `m`; the pair's axis is `-m`, which must not lie
