@@ -11,7 +11,8 @@
 //! it may turn up to the dihedral angle.
 
 use super::contact::{ContactList, FeatureId};
-use super::polyhedron::{polyhedron_manifold_posed, Polyhedron, PosedPolyhedron};
+use super::mesh_hull::{posed_hull, triangle_hull_manifold, EdgeScratch};
+use super::polyhedron::Polyhedron;
 use crate::math::Aabb;
 use crate::math::{Isometry, Real, Vec3};
 use crate::query::closest_points::closest_point_segment;
@@ -95,6 +96,70 @@ pub fn convex_aabb(b: ConvexRef<'_>, pose_ab: &Isometry) -> crate::math::Aabb {
     crate::math::Aabb::new(min, max)
 }
 
+/// The closed-form extent of a sphere, capsule or box along any direction, for the plane
+/// cull of [`mesh_convex_contacts`]: a triangle whose plane the shape clears by more than the
+/// prediction (on either side) is farther than the prediction, so it is skipped before its
+/// contact test (the midphase's boxes let through triangles whose planes pass beside the
+/// shape, e.g. the neighbours of the one under a body on a slope). Bullet's
+/// `btConvexPlaneCollisionAlgorithm` and Box2D's `b2CollidePolygons` reject on the same
+/// face axis first. Other shapes have their own first face test (hulls) or none.
+#[derive(Debug, Clone, Copy)]
+struct PlaneSlab {
+    /// Centre (sphere, box) or first segment end (capsule) in the mesh frame.
+    p: Vec3,
+    /// Second segment end (capsule), else `p`.
+    q: Vec3,
+    /// Radius (sphere, capsule), 0 for a box.
+    r: Real,
+    /// The box's half extents along its axes `axes` (zero otherwise).
+    half: Vec3,
+    axes: [Vec3; 3],
+    /// Round-off margin added to the prediction (relative to the shape's position and size).
+    tol: Real,
+}
+
+impl PlaneSlab {
+    fn new(b: ConvexRef<'_>, pose_ab: &Isometry) -> Option<PlaneSlab> {
+        let c = pose_ab.translation;
+        let (p, q, r, half, axes) = match b {
+            ConvexRef::Sphere(s) => (c, c, s.radius(), Vec3::ZERO, [Vec3::ZERO; 3]),
+            ConvexRef::Capsule(k) => {
+                let (p, q) = k.segment();
+                let (p, q) = (pose_ab.transform_point(p), pose_ab.transform_point(q));
+                (p, q, k.radius(), Vec3::ZERO, [Vec3::ZERO; 3])
+            }
+            ConvexRef::Cuboid(x) => {
+                let m = pose_ab.rotation_matrix();
+                (c, c, 0.0, x.half_extents(), [m.x_axis, m.y_axis, m.z_axis])
+            }
+            _ => return None,
+        };
+        let size = r + half.x + half.y + half.z + (q - p).length();
+        let tol = 1.0e-4 * (1.0 + size + p.abs().max_element());
+        Some(PlaneSlab {
+            p,
+            q,
+            r,
+            half,
+            axes,
+            tol,
+        })
+    }
+
+    /// True when the shape lies entirely more than `prediction` (plus round-off) above or
+    /// below the plane `n · x = off` (`n` unit).
+    #[inline]
+    fn clear_of_plane(&self, n: Vec3, off: Real, prediction: Real) -> bool {
+        let ext = self.r
+            + self.half.x * n.dot(self.axes[0]).abs()
+            + self.half.y * n.dot(self.axes[1]).abs()
+            + self.half.z * n.dot(self.axes[2]).abs();
+        let (dp, dq) = (n.dot(self.p) - off, n.dot(self.q) - off);
+        let gap = prediction + self.tol + ext;
+        (dp > gap && dq > gap) || (dp < -gap && dq < -gap)
+    }
+}
+
 /// Mixes a triangle or child index into a feature id (deterministic).
 #[inline]
 pub fn mix_feature(index: u32, id: FeatureId) -> FeatureId {
@@ -166,15 +231,35 @@ pub fn mesh_convex_contacts<M: ContactTriangles + ?Sized>(
     out: &mut ContactList,
 ) {
     let aabb = convex_aabb(b, pose_ab).expanded(prediction.max(0.0));
+    contacts_in_box(mesh, b, pose_ab, prediction, &aabb, tri_contacts, out);
+}
+
+/// [`mesh_convex_contacts`] with B's box (mesh frame, expanded by the prediction) given.
+fn contacts_in_box<M: ContactTriangles + ?Sized>(
+    mesh: &M,
+    b: ConvexRef<'_>,
+    pose_ab: &Isometry,
+    prediction: Real,
+    aabb: &Aabb,
+    tri_contacts: &mut dyn FnMut(&Triangle, &mut ContactList),
+    out: &mut ContactList,
+) {
     // Triangles in index order, so a mesh and a heightfield with the same triangles give
     // the same sequence of points (and the same reduced manifold).
     let mut tris: SmallVec<[u32; 64]> = SmallVec::new();
-    mesh.for_each_candidate(&aabb, &mut |t| tris.push(t));
+    mesh.for_each_candidate(aabb, &mut |t| tris.push(t));
     tris.sort_unstable();
+    let slab = PlaneSlab::new(b, pose_ab);
     for t in tris {
         let [p, q, r] = mesh.corners(t);
         let tri = Triangle { a: p, b: q, c: r };
-        if tri.normal().is_none() || !tri.vertices().iter().all(|v| v.is_finite()) {
+        let Some(n) = tri.normal() else {
+            continue;
+        };
+        if !tri.vertices().iter().all(|v| v.is_finite()) {
+            continue;
+        }
+        if slab.is_some_and(|s| s.clear_of_plane(n, n.dot(p), prediction)) {
             continue;
         }
         let start = out.len();
@@ -197,9 +282,11 @@ pub fn mesh_convex_contacts<M: ContactTriangles + ?Sized>(
 }
 
 /// Triangles A against convex hull B: [`mesh_convex_contacts`] with the triangle–hull
-/// separating-axis test of [`super::polyhedron`], the hull placed in the mesh's frame once
-/// (vertices, face planes, edge arcs) for all the triangles instead of once per triangle.
-/// The contacts are those of the per-triangle `convex_convex` path, bit for bit.
+/// separating-axis test of [`super::mesh_hull`], the hull placed in the mesh's frame once
+/// (vertices, face planes; [`posed_hull`]) for all the triangles instead of once per
+/// triangle. Given the same placed hull the contacts are those of the per-triangle
+/// `convex_convex` path bit for bit; the placement by a rotation matrix rounds differently
+/// from the quaternion's, by a few ulps.
 pub fn mesh_hull_contacts<M: ContactTriangles + ?Sized>(
     mesh: &M,
     hull: &ConvexHull,
@@ -208,12 +295,25 @@ pub fn mesh_hull_contacts<M: ContactTriangles + ?Sized>(
     out: &mut ContactList,
 ) {
     let pb = Polyhedron::from_hull(hull);
-    let mut posed: Option<PosedPolyhedron> = None;
+    // The hull is placed once per pair; its placed vertices also give its box (cheaper
+    // than six support queries).
+    let posed = posed_hull(&pb, pose_ab);
+    let Some(&first) = posed.vertices.first() else {
+        return;
+    };
+    let (lo, hi) = posed.vertices[1..]
+        .iter()
+        .fold((first, first), |(lo, hi), v| (lo.min(*v), hi.max(*v)));
+    let aabb = Aabb::new(lo, hi).expanded(prediction.max(0.0));
+    let mut scratch = EdgeScratch::default();
     let mut tri_contacts = |t: &Triangle, out: &mut ContactList| {
-        let posed = posed.get_or_insert_with(|| PosedPolyhedron::new(&pb, pose_ab, true));
         let pa = Polyhedron::from_triangle(t);
-        polyhedron_manifold_posed(&pa, &pb, posed, pose_ab, prediction, out);
+        triangle_hull_manifold(&pa, &pb, &posed, pose_ab, prediction, &mut scratch, out);
     };
     let b = ConvexRef::ConvexHull(hull);
-    mesh_convex_contacts(mesh, b, pose_ab, prediction, &mut tri_contacts, out);
+    contacts_in_box(mesh, b, pose_ab, prediction, &aabb, &mut tri_contacts, out);
 }
+
+#[cfg(test)]
+#[path = "mesh_tests.rs"]
+mod tests;

@@ -24,6 +24,7 @@ pub mod contact_cuboid_cuboid;
 pub mod convex;
 pub mod dispatcher;
 pub mod mesh;
+mod mesh_hull;
 pub mod polyhedron;
 pub mod polyhedron_guided;
 mod polyhedron_sat;

@@ -383,11 +383,41 @@ pub(crate) fn polyhedron_manifold_posed(
     if sb > prediction {
         return;
     }
-    let start = out.len();
-    let (se, ia, ib, axis) = edge_query(a, b, posed);
-    if se > prediction {
+    let edge = edge_query(a, b, posed);
+    if edge.0 > prediction {
         return;
     }
+    manifold_from_sat(
+        a,
+        b,
+        posed,
+        pose_ab,
+        prediction,
+        (sa, fa),
+        (sb, fb),
+        edge,
+        out,
+    );
+}
+
+/// The manifold of [`polyhedron_manifold_posed`] once the separating-axis test has run and
+/// found no separating axis beyond `prediction`: the best face of A `(sa, fa)`, of B
+/// `(sb, fb)` and the best edge pair `(se, ia, ib, axis)` (axis from A towards B). Shared
+/// with the triangle-specialised test of [`super::mesh_hull`].
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn manifold_from_sat(
+    a: &Polyhedron,
+    b: &Polyhedron,
+    posed: &PosedPolyhedron,
+    pose_ab: &Isometry,
+    prediction: Real,
+    (sa, fa): (Real, usize),
+    (sb, fb): (Real, usize),
+    (se, ia, ib, axis): (Real, usize, usize, Vec3),
+    out: &mut Vec<(Contact, FeatureId)>,
+) {
+    let vb = &posed.vertices[..];
+    let start = out.len();
     let feature = choose_feature(sa, sb, se);
     if feature == Feature::Edge {
         let ea = a.edges[ia];
