@@ -215,6 +215,7 @@ impl WideConstraint {
         let dirs = [self.normal, self.tangent[0], self.tangent[1]];
         for (k, p) in self.points[..self.len].iter_mut().enumerate() {
             let present = lens.simd_gt(W::splat(k as Real));
+            let all_present = present.all();
             let (ra, rb) = (inputs.arm_a[k], inputs.arm_b[k]);
             let [t0, t1] = &mut p.tangent_rows;
             for (row, d) in [&mut p.normal_row, t0, t1].into_iter().zip(dirs) {
@@ -223,12 +224,24 @@ impl WideConstraint {
                 let k = inv_m + ang_a.dot(inv_ang_a) + ang_b.dot(inv_ang_b);
                 // `inv_or_zero`, and no mass for an absent point.
                 let mass = (k.simd_gt(eps) & present).select(one / k, zero);
-                *row = WideRow {
-                    ang_a: keep(present, ang_a),
-                    ang_b: keep(present, ang_b),
-                    inv_ang_a: keep(present, inv_ang_a),
-                    inv_ang_b: keep(present, inv_ang_b),
-                    mass,
+                *row = if all_present {
+                    WideRow {
+                        ang_a,
+                        ang_b,
+                        inv_ang_a,
+                        inv_ang_b,
+                        mass,
+                    }
+                } else {
+                    // Zero rows (not `-0.0` from `0 × d`) in the absent lanes, as a scalar
+                    // `ContactRow::ZERO`.
+                    WideRow {
+                        ang_a: keep(present, ang_a),
+                        ang_b: keep(present, ang_b),
+                        inv_ang_a: keep(present, inv_ang_a),
+                        inv_ang_b: keep(present, inv_ang_b),
+                        mass,
+                    }
                 };
             }
         }
