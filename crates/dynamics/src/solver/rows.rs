@@ -77,6 +77,9 @@ pub(crate) struct Row {
     pub impulse: Real,
     /// The joint's warm-starting slot of this row (`< ROW_SLOTS`).
     pub slot: u8,
+    /// `lin` is zero (an angular row): the solve skips the linear terms, which would only
+    /// add and subtract zeros.
+    pub angular: bool,
 }
 
 impl Row {
@@ -102,6 +105,7 @@ impl Row {
             hi,
             impulse: 0.0,
             slot,
+            angular: j[0] == Vec3::ZERO,
         }
     }
 
@@ -113,6 +117,7 @@ impl Row {
         self.ang_a = j[1];
         self.ang_b = j[2];
         self.c = c;
+        self.angular = j[0] == Vec3::ZERO;
     }
 
     /// Computes the inertia-weighted angular Jacobians and the effective mass.
@@ -126,16 +131,26 @@ impl Row {
         self.inv_k = inv_or_zero(k);
     }
 
+    /// `J v`. An angular row leaves out `lin · (v_b − v_a)`, which is ±0 there (the sum
+    /// differs at most in the sign of a zero result).
     #[inline]
     pub(crate) fn velocity(&self, a: &Motion, b: &Motion) -> Real {
-        self.lin.dot(b.v - a.v) + self.ang_a.dot(a.w) + self.ang_b.dot(b.w)
+        let angular = self.ang_a.dot(a.w);
+        if self.angular {
+            return angular + self.ang_b.dot(b.w);
+        }
+        self.lin.dot(b.v - a.v) + angular + self.ang_b.dot(b.w)
     }
 
+    /// Applies `lambda` along the row (`-` to A, `+` to B); an angular row changes no
+    /// linear velocity.
     #[inline]
     pub(crate) fn apply(&self, a: &mut Motion, b: &mut Motion, lambda: Real) {
-        a.v -= self.lin * (a.inv_m * lambda);
+        if !self.angular {
+            a.v -= self.lin * (a.inv_m * lambda);
+            b.v += self.lin * (b.inv_m * lambda);
+        }
         a.w += self.ia * lambda;
-        b.v += self.lin * (b.inv_m * lambda);
         b.w += self.ib * lambda;
     }
 
@@ -269,10 +284,30 @@ impl Block {
     }
 
     /// One block update of `rows` (the block's rows), with the same soft feedback as
-    /// [`Row::solve`] gives an equality row.
+    /// [`Row::solve`] gives an equality row. Dispatches on the block size to a loop of fixed
+    /// length, which the compiler unrolls (no per-row loop bookkeeping or index checks).
     pub fn solve(
         &self,
         rows: &mut [Row],
+        a: &mut Motion,
+        b: &mut Motion,
+        soft: Softness,
+        use_bias: bool,
+    ) {
+        match rows {
+            [r0, r1, r2] => self.solve_n([r0, r1, r2], a, b, soft, use_bias),
+            [r0, r1] => self.solve_n([r0, r1], a, b, soft, use_bias),
+            [r0] => self.solve_n([r0], a, b, soft, use_bias),
+            _ => {}
+        }
+    }
+
+    /// [`Block::solve`] on `N` rows: `λ = -K⁻¹ (J v + bias)·mass_scale - impulse·impulse_scale`,
+    /// with the entries past `N` zero (and `K⁻¹` padded with the identity).
+    #[inline(always)]
+    fn solve_n<const N: usize>(
+        &self,
+        mut rows: [&mut Row; N],
         a: &mut Motion,
         b: &mut Motion,
         soft: Softness,
