@@ -60,10 +60,12 @@ impl ContactRow {
         d.dot(b.v - a.v) + self.ang_b.dot(b.w) - self.ang_a.dot(a.w)
     }
 
-    /// Relative displacement along the row from the position deltas (`J Δx`).
+    /// Relative displacement along the row from the position deltas (`J Δx`), given its
+    /// linear part `d · (Δx_b − Δx_a)`, which is the same for every point of a constraint
+    /// (computed once per constraint and pass).
     #[inline(always)]
-    fn displacement(&self, d: Vec3, a: &SolverBody, b: &SolverBody) -> Real {
-        d.dot(b.dp - a.dp) + self.ang_b.dot(b.dq) - self.ang_a.dot(a.dq)
+    fn displacement(&self, linear: Real, a: &SolverBody, b: &SolverBody) -> Real {
+        linear + self.ang_b.dot(b.dq) - self.ang_a.dot(a.dq)
     }
 
     /// Applies impulse `lambda` along the row: `-λ` to A, `+λ` to B.
@@ -99,6 +101,11 @@ pub(crate) struct PointConstraint {
     pub tangent_impulse: [Real; 2],
     pub push_impulse: Real,
     pub max_normal_impulse: Real,
+    /// Lever arm from A's centre of mass to the anchor, from which the rows are built (the
+    /// SIMD build computes the rows of four constraints at once from these).
+    pub arm_a: Vec3,
+    /// Lever arm from B's centre of mass to the anchor.
+    pub arm_b: Vec3,
 }
 
 /// One prepared manifold.
@@ -127,6 +134,8 @@ impl PointConstraint {
         tangent_impulse: [0.0; 2],
         push_impulse: 0.0,
         max_normal_impulse: 0.0,
+        arm_a: Vec3::ZERO,
+        arm_b: Vec3::ZERO,
     };
 }
 
@@ -220,17 +229,18 @@ pub(crate) fn prepare(
         colouring,
     );
     let order = &colouring.order;
-    let make = |k: usize, out: &mut ContactConstraint| {
+    let make = |k: usize, out: &mut ContactConstraint, rows: bool| {
         let m_index = selected[order[k]];
+        let m = &manifolds[m_index];
         prepare_one(
             out,
-            &manifolds[m_index],
+            m,
             m_index,
             set,
             bodies,
             impulse_in,
-            soft,
-            static_soft,
+            (soft, static_soft),
+            rows,
         )
     };
     if simd {
@@ -240,7 +250,7 @@ pub(crate) fn prepare(
         cons.clear();
         cons.extend((0..order.len()).map(|k| {
             let mut c = ContactConstraint::EMPTY;
-            make(k, &mut c);
+            make(k, &mut c, true);
             c
         }));
     }
@@ -249,6 +259,10 @@ pub(crate) fn prepare(
 /// Writes the constraint of manifold `m` (index `m_index`), which touches an awake dynamic
 /// body, into `out`: every field and the points `..len`; the points from `len` on are left
 /// as they were (nothing reads them), so a reused `out` is neither zeroed nor copied.
+/// `(soft, static_soft)` are the softness between two dynamic bodies and against a
+/// non-dynamic one. Without `rows` the Jacobian rows are left stale: the SIMD build
+/// computes them four constraints at a time from the lever arms
+/// (`contact_simd::WideConstraint::finish`), with the same arithmetic as [`ContactRow::new`].
 #[allow(clippy::too_many_arguments)]
 fn prepare_one(
     out: &mut ContactConstraint,
@@ -257,8 +271,8 @@ fn prepare_one(
     set: &BodySet,
     bodies: &[SolverBody],
     impulse_in: Real,
-    soft: Softness,
-    static_soft: Softness,
+    (soft, static_soft): (Softness, Softness),
+    rows: bool,
 ) {
     let (a, b) = (m.body_a.index as usize, m.body_b.index as usize);
     let (ba, bb) = (&bodies[a], &bodies[b]);
@@ -274,7 +288,11 @@ fn prepare_one(
         *arm = (ra, rb);
         let dv = bb.point_velocity(rb) - ba.point_velocity(ra);
         centre_velocity += dv;
-        pt.normal_row = ContactRow::new(ba, bb, ra, rb, n);
+        if rows {
+            pt.normal_row = ContactRow::new(ba, bb, ra, rb, n);
+        }
+        pt.arm_a = ra;
+        pt.arm_b = rb;
         pt.separation = p.separation;
         pt.relative_velocity = dv.dot(n);
         pt.normal_impulse = p.normal_impulse * impulse_in;
@@ -287,11 +305,13 @@ fn prepare_one(
     }
     let t1 = friction_direction(m.tangent, n, centre_velocity / len as Real);
     let t2 = n.cross(t1);
-    for (pt, &(ra, rb)) in out.points[..len].iter_mut().zip(&arms) {
-        pt.tangent_rows = [
-            ContactRow::new(ba, bb, ra, rb, t1),
-            ContactRow::new(ba, bb, ra, rb, t2),
-        ];
+    if rows {
+        for (pt, &(ra, rb)) in out.points[..len].iter_mut().zip(&arms) {
+            pt.tangent_rows = [
+                ContactRow::new(ba, bb, ra, rb, t1),
+                ContactRow::new(ba, bb, ra, rb, t2),
+            ];
+        }
     }
     out.a = a;
     out.b = b;
@@ -409,7 +429,8 @@ pub(crate) fn solve_push_si(
             continue;
         }
         let row = &p.normal_row;
-        let vn = row.displacement(c.normal, a, b);
+        // The pushes of the previous points moved `dp`: the linear part is recomputed.
+        let vn = row.displacement(c.normal.dot(b.dp - a.dp), a, b);
         let new = (p.push_impulse + row.mass * (target - vn)).max(0.0);
         row.apply_push(c.normal, new - p.push_impulse, a, b);
         p.push_impulse = new;
@@ -429,9 +450,10 @@ pub(crate) fn solve_soft(
     use_bias: bool,
 ) {
     solve_friction(c, a, b);
+    let linear = c.normal.dot(b.dp - a.dp);
     for p in c.points[..c.len].iter_mut() {
         let row = &p.normal_row;
-        let s = p.separation + row.displacement(c.normal, a, b);
+        let s = p.separation + row.displacement(linear, a, b);
         let (bias, mass_scale, impulse_scale) = if s > 0.0 {
             (s * inv_h, 1.0, 0.0)
         } else if use_bias {

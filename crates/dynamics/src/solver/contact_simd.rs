@@ -112,10 +112,12 @@ impl WideRow {
         d.dot(b.v.sub(a.v)) + self.ang_b.dot(b.w) - self.ang_a.dot(a.w)
     }
 
-    /// `J Δx`, as `ContactRow::displacement`.
+    /// `J Δx`, as `ContactRow::displacement`, given its linear part `d · (Δx_b − Δx_a)`
+    /// (the same for every point of a constraint: the position deltas do not change during
+    /// a pass, so the solve computes it once per constraint).
     #[inline(always)]
-    fn displacement(&self, d: V3, a: &WideBody, b: &WideBody) -> W {
-        d.dot(b.dp.sub(a.dp)) + self.ang_b.dot(b.dq) - self.ang_a.dot(a.dq)
+    fn displacement(&self, linear: W, a: &WideBody, b: &WideBody) -> W {
+        linear + self.ang_b.dot(b.dq) - self.ang_a.dot(a.dq)
     }
 
     /// As `ContactRow::apply`.
@@ -438,9 +440,10 @@ pub(crate) fn solve_soft(
     let (zero, one) = (W::splat(0.0), W::splat(1.0));
     let (inv_h, min_bias) = (W::splat(inv_h), W::splat(-max_push));
     let n = c.normal;
+    let linear = n.dot(b.dp.sub(a.dp));
     for p in c.points[..c.len].iter_mut() {
         let row = &p.normal_row;
-        let s = p.separation + row.displacement(n, a, b);
+        let s = p.separation + row.displacement(linear, a, b);
         let gap = s.simd_gt(zero);
         let (bias, mass_scale, impulse_scale) = if use_bias {
             (

@@ -10,9 +10,9 @@
 
 use super::{WideConstraint, WidePoint, WideRow, WideScratch, LANES, NONE, V3, W};
 use crate::contact::{ContactManifold, MAX_MANIFOLD_POINTS};
-use crate::solver::contact::{ContactConstraint, ContactRow};
+use crate::solver::contact::ContactConstraint;
 use crate::solver::SolverBody;
-use carom_collision::math::{Real, Vec3};
+use carom_collision::math::{Mat3, Real, Vec3};
 use std::ops::Range;
 
 /// Sets lane `l` of `w` to `x`.
@@ -35,29 +35,73 @@ fn get3(v: &V3, l: usize) -> Vec3 {
     Vec3::new(v.x.as_array()[l], v.y.as_array()[l], v.z.as_array()[l])
 }
 
-impl WideRow {
-    /// Lane `l` becomes `r` (a zero row leaves its impulse at zero).
-    #[inline(always)]
-    fn set_lane(&mut self, l: usize, r: &ContactRow) {
-        put3(&mut self.ang_a, l, r.ang_a);
-        put3(&mut self.ang_b, l, r.ang_b);
-        put3(&mut self.inv_ang_a, l, r.inv_ang_a);
-        put3(&mut self.inv_ang_b, l, r.inv_ang_b);
-        put(&mut self.mass, l, r.mass);
+/// The inputs of the row build of one wide constraint that the lanes do not keep: the lever
+/// arms of every point and the inverse world inertias of every lane's bodies. Filled lane by
+/// lane ([`WideConstraint::set_lane`]) and consumed by [`WideConstraint::finish`].
+pub(super) struct RowInputs {
+    arm_a: [V3; MAX_MANIFOLD_POINTS],
+    arm_b: [V3; MAX_MANIFOLD_POINTS],
+    inv_i_a: [Mat3; LANES],
+    inv_i_b: [Mat3; LANES],
+}
+
+impl Default for RowInputs {
+    fn default() -> Self {
+        RowInputs {
+            arm_a: [V3::default(); MAX_MANIFOLD_POINTS],
+            arm_b: [V3::default(); MAX_MANIFOLD_POINTS],
+            inv_i_a: [Mat3::ZERO; LANES],
+            inv_i_b: [Mat3::ZERO; LANES],
+        }
+    }
+}
+
+/// An inverse inertia of every lane, as nine lane vectors (`m[c][r]`: column `c`, row `r`).
+#[inline(always)]
+fn wide_mat(m: &[Mat3; LANES]) -> [[W; 3]; 3] {
+    let e = |c: usize, r: usize| W::from(std::array::from_fn::<Real, LANES, _>(|l| m[l].col(c)[r]));
+    [0, 1, 2].map(|c| [0, 1, 2].map(|r| e(c, r)))
+}
+
+/// `m * v` in every lane, in glam's order (`x_axis·v.x + y_axis·v.y + z_axis·v.z`, summed
+/// left to right per component), so each lane equals the scalar `Mat3 * Vec3`.
+#[inline(always)]
+fn mat_mul(m: &[[W; 3]; 3], v: V3) -> V3 {
+    let r = |i: usize| m[0][i] * v.x + m[1][i] * v.y + m[2][i] * v.z;
+    V3 {
+        x: r(0),
+        y: r(1),
+        z: r(2),
+    }
+}
+
+/// `a × b` in every lane, in glam's order.
+#[inline(always)]
+fn cross(a: V3, b: V3) -> V3 {
+    V3 {
+        x: a.y * b.z - b.y * a.z,
+        y: a.z * b.x - b.z * a.x,
+        z: a.x * b.y - b.x * a.y,
+    }
+}
+
+/// Lanes of `v` where `mask` is set, zero elsewhere.
+#[inline(always)]
+fn keep(mask: W, v: V3) -> V3 {
+    let zero = W::splat(0.0);
+    V3 {
+        x: mask.select(v.x, zero),
+        y: mask.select(v.y, zero),
+        z: mask.select(v.z, zero),
     }
 }
 
 impl WidePoint {
-    /// Lane `l` becomes point `k` of `c`, or an empty point when `c` has fewer points.
+    /// Lane `l` becomes point `k` of `c` but its rows (built by [`WideConstraint::finish`]),
+    /// or an empty point when `c` has fewer points.
     #[inline(always)]
     fn set_lane(&mut self, l: usize, c: &ContactConstraint, k: usize) {
         let p = (k < c.len).then(|| &c.points[k]);
-        let zero = &ContactRow::ZERO;
-        self.normal_row
-            .set_lane(l, p.map_or(zero, |p| &p.normal_row));
-        for (j, row) in self.tangent_rows.iter_mut().enumerate() {
-            row.set_lane(l, p.map_or(zero, |p| &p.tangent_rows[j]));
-        }
         let val = |f: fn(&super::super::contact::PointConstraint) -> Real| p.map_or(0.0, f);
         put(&mut self.separation, l, val(|p| p.separation));
         put(&mut self.relative_velocity, l, val(|p| p.relative_velocity));
@@ -105,10 +149,17 @@ impl WideConstraint {
     }
 
     /// Lane `l` becomes constraint `c` (whose bodies are `bodies[c.a]`, `bodies[c.b]`), or a
-    /// padding lane (zero rows, no bodies) for `None`. Every field of the lane is written but
-    /// the points from `c.len` on: [`WideConstraint::pad_points`] zeroes those the solve
-    /// reads once the group is complete.
-    fn set_lane(&mut self, l: usize, c: Option<&ContactConstraint>, bodies: &[SolverBody]) {
+    /// padding lane (no points, no bodies) for `None`. Every field of the lane is written
+    /// but the rows and the points from `c.len` on; the lever arms and inverse inertias the
+    /// rows are built from go to `inputs` (zero past `c.len` and for padding).
+    /// [`WideConstraint::finish`] completes the group.
+    fn set_lane(
+        &mut self,
+        l: usize,
+        c: Option<&ContactConstraint>,
+        bodies: &[SolverBody],
+        inputs: &mut RowInputs,
+    ) {
         let c = c.unwrap_or(&ContactConstraint::EMPTY);
         let pad = c.len == 0;
         let (a, b) = if pad { (NONE, NONE) } else { (c.a, c.b) };
@@ -118,16 +169,12 @@ impl WideConstraint {
         self.write_b[l] = !pad && bodies[b].dynamic;
         self.manifold[l] = if pad { NONE } else { c.manifold };
         self.lens[l] = c.len;
-        put(
-            &mut self.inv_m_a,
-            l,
-            if pad { 0.0 } else { bodies[a].inv_m },
-        );
-        put(
-            &mut self.inv_m_b,
-            l,
-            if pad { 0.0 } else { bodies[b].inv_m },
-        );
+        let body = |s: usize| (!pad).then(|| &bodies[s]);
+        let (ba, bb) = (body(a), body(b));
+        put(&mut self.inv_m_a, l, ba.map_or(0.0, |x| x.inv_m));
+        put(&mut self.inv_m_b, l, bb.map_or(0.0, |x| x.inv_m));
+        inputs.inv_i_a[l] = ba.map_or(Mat3::ZERO, |x| x.inv_i);
+        inputs.inv_i_b[l] = bb.map_or(Mat3::ZERO, |x| x.inv_i);
         put3(&mut self.normal, l, c.normal);
         put3(&mut self.tangent[0], l, c.tangent[0]);
         put3(&mut self.tangent[1], l, c.tangent[1]);
@@ -139,23 +186,71 @@ impl WideConstraint {
         for (k, wp) in self.points[..c.len].iter_mut().enumerate() {
             wp.set_lane(l, c, k);
         }
+        for k in 0..MAX_MANIFOLD_POINTS {
+            let p = (k < c.len).then(|| &c.points[k]);
+            put3(&mut inputs.arm_a[k], l, p.map_or(Vec3::ZERO, |p| p.arm_a));
+            put3(&mut inputs.arm_b[k], l, p.map_or(Vec3::ZERO, |p| p.arm_b));
+        }
     }
 
-    /// Zeroes the points `lens[l]..len` of every lane `l`, which the solve reads (it runs
-    /// `len` points in every lane). Points from `len` on are never read and keep whatever
-    /// they held: with the constraints of a colour grouped by point count, most groups have
-    /// lanes of equal length, and a group of one-point lanes writes one point instead of four.
-    fn pad_points(&mut self) {
+    /// Completes a group whose lanes are all set: zeroes the points `lens[l]..len` of every
+    /// lane `l`, which the solve reads (it runs `len` points in every lane), and builds the
+    /// rows of the points `..len` in all lanes at once, as `ContactRow::new` does for one
+    /// (same operations in the same order, so the same bits); rows of absent points are
+    /// zero. Points from `len` on are never read and keep whatever they held: with the
+    /// constraints of a colour grouped by point count, most groups have lanes of equal
+    /// length, and a group of one-point lanes builds one point instead of four.
+    fn finish(&mut self, inputs: &RowInputs) {
         for l in 0..LANES {
             for k in self.lens[l]..self.len {
                 self.points[k].set_lane(l, &ContactConstraint::EMPTY, k);
             }
         }
+        let (ia, ib) = (wide_mat(&inputs.inv_i_a), wide_mat(&inputs.inv_i_b));
+        let inv_m = self.inv_m_a + self.inv_m_b;
+        let lens = W::from(std::array::from_fn::<Real, LANES, _>(|l| {
+            self.lens[l] as Real
+        }));
+        let (zero, one, eps) = (W::splat(0.0), W::splat(1.0), W::splat(Real::EPSILON));
+        let dirs = [self.normal, self.tangent[0], self.tangent[1]];
+        for (k, p) in self.points[..self.len].iter_mut().enumerate() {
+            let present = lens.simd_gt(W::splat(k as Real));
+            let all_present = present.all();
+            let (ra, rb) = (inputs.arm_a[k], inputs.arm_b[k]);
+            let [t0, t1] = &mut p.tangent_rows;
+            for (row, d) in [&mut p.normal_row, t0, t1].into_iter().zip(dirs) {
+                let (ang_a, ang_b) = (cross(ra, d), cross(rb, d));
+                let (inv_ang_a, inv_ang_b) = (mat_mul(&ia, ang_a), mat_mul(&ib, ang_b));
+                let k = inv_m + ang_a.dot(inv_ang_a) + ang_b.dot(inv_ang_b);
+                // `inv_or_zero`, and no mass for an absent point.
+                let mass = (k.simd_gt(eps) & present).select(one / k, zero);
+                *row = if all_present {
+                    WideRow {
+                        ang_a,
+                        ang_b,
+                        inv_ang_a,
+                        inv_ang_b,
+                        mass,
+                    }
+                } else {
+                    // Zero rows (not `-0.0` from `0 × d`) in the absent lanes, as a scalar
+                    // `ContactRow::ZERO`.
+                    WideRow {
+                        ang_a: keep(present, ang_a),
+                        ang_b: keep(present, ang_b),
+                        inv_ang_a: keep(present, inv_ang_a),
+                        inv_ang_b: keep(present, inv_ang_b),
+                        mass,
+                    }
+                };
+            }
+        }
     }
 }
 
-/// Builds the constraints of a step: `make(k, out)` prepares the constraint at position `k` of
-/// the colour order, which will have `points(k)` points; `ranges` are the colour ranges of
+/// Builds the constraints of a step: `make(k, out, rows)` prepares the constraint at
+/// position `k` of the colour order (its Jacobian rows only when `rows`: the lanes' rows
+/// are built four at a time from the lever arms by [`WideConstraint::finish`]), which will have `points(k)` points; `ranges` are the colour ranges of
 /// that order, the last being the overflow colour. The constraints of each colour but the
 /// last go four at a time into the lanes of `out.cons` (reusing last step's wide
 /// constraints); the overflow colour's go to `cons` (cleared first), and `out.overflow` is
@@ -172,7 +267,7 @@ pub(crate) fn fill(
     ranges: &[Range<usize>],
     bodies: &[SolverBody],
     points: impl Fn(usize) -> usize,
-    mut make: impl FnMut(usize, &mut ContactConstraint),
+    mut make: impl FnMut(usize, &mut ContactConstraint, bool),
 ) {
     cons.clear();
     out.ranges.clear();
@@ -184,6 +279,7 @@ pub(crate) fn fill(
     let bucket = |k: usize| points(k).clamp(1, MAX_MANIFOLD_POINTS);
     // One constraint at a time is prepared here and written into its lane.
     let mut c = ContactConstraint::EMPTY;
+    let mut inputs = RowInputs::default();
     let mut used = 0;
     for r in colours {
         let start = used;
@@ -200,26 +296,28 @@ pub(crate) fn fill(
                     lane = 0;
                 }
                 let w = &mut out.cons[used - 1];
-                make(k, &mut c);
+                make(k, &mut c, false);
                 w.len = w.len.max(c.len);
-                w.set_lane(lane, Some(&c), bodies);
+                w.set_lane(lane, Some(&c), bodies, &mut inputs);
                 lane += 1;
+                if lane == LANES {
+                    w.finish(&inputs);
+                }
             }
         }
-        if used > start {
+        if used > start && lane < LANES {
+            let w = &mut out.cons[used - 1];
             for l in lane..LANES {
-                out.cons[used - 1].set_lane(l, None, bodies);
+                w.set_lane(l, None, bodies, &mut inputs);
             }
+            w.finish(&inputs);
         }
         out.ranges.push(start..used);
     }
     out.cons.truncate(used);
-    for w in &mut out.cons {
-        w.pad_points();
-    }
     cons.extend(overflow.clone().map(|k| {
         let mut c = ContactConstraint::EMPTY;
-        make(k, &mut c);
+        make(k, &mut c, true);
         c
     }));
     out.overflow = 0..cons.len();
@@ -239,7 +337,7 @@ pub(crate) fn build(
     let mut scratch = Vec::new();
     let points = |k: usize| cons[k].len;
     let Some((overflow, colours)) = ranges.split_last() else {
-        fill(out, &mut scratch, ranges, bodies, points, |k, c| {
+        fill(out, &mut scratch, ranges, bodies, points, |k, c, _| {
             *c = cons[k].clone()
         });
         return;
@@ -247,7 +345,7 @@ pub(crate) fn build(
     // The overflow colour is left out of the lanes and kept in `cons` by range.
     let mut rs: Vec<Range<usize>> = colours.to_vec();
     rs.push(overflow.start..overflow.start);
-    fill(out, &mut scratch, &rs, bodies, points, |k, c| {
+    fill(out, &mut scratch, &rs, bodies, points, |k, c, _| {
         *c = cons[k].clone()
     });
     out.overflow = overflow.clone();

@@ -88,6 +88,8 @@ fn scene(rng: &mut Rng, count: usize) -> (Vec<SolverBody>, Vec<ContactConstraint
                 normal_impulse: rng.range(0.0, 2.0),
                 tangent_impulse: [rng.range(-0.5, 0.5), rng.range(-0.5, 0.5)],
                 push_impulse: 0.0,
+                arm_a: ra,
+                arm_b: rb,
                 max_normal_impulse: if rng.next() < 0.2 {
                     0.0
                 } else {
@@ -313,7 +315,7 @@ fn fill_writes_every_lane_and_overwrites_stale_ones() {
             &ranges,
             &bodies,
             points,
-            |k, c| {
+            |k, c, _| {
                 made.set(made.get() + 1);
                 *c = cons[k].clone();
             },
@@ -383,7 +385,7 @@ fn store_matches_the_scalar_store() {
         &[0..10, 10..10],
         &bodies,
         points,
-        |k, c| *c = cons[k].clone(),
+        |k, c, _| *c = cons[k].clone(),
     );
     let (mut m_wide, mut m_scalar) = (manifolds.clone(), manifolds);
     store(&wide, &mut m_wide, 4.0);

@@ -77,6 +77,9 @@ pub(crate) struct Row {
     pub impulse: Real,
     /// The joint's warm-starting slot of this row (`< ROW_SLOTS`).
     pub slot: u8,
+    /// `lin` is zero (an angular row): the solve skips the linear terms, which would only
+    /// add and subtract zeros.
+    pub angular: bool,
 }
 
 impl Row {
@@ -102,6 +105,7 @@ impl Row {
             hi,
             impulse: 0.0,
             slot,
+            angular: j[0] == Vec3::ZERO,
         }
     }
 
@@ -113,6 +117,7 @@ impl Row {
         self.ang_a = j[1];
         self.ang_b = j[2];
         self.c = c;
+        self.angular = j[0] == Vec3::ZERO;
     }
 
     /// Computes the inertia-weighted angular Jacobians and the effective mass.
@@ -126,16 +131,26 @@ impl Row {
         self.inv_k = inv_or_zero(k);
     }
 
+    /// `J v`. An angular row leaves out `lin · (v_b − v_a)`, which is ±0 there (the sum
+    /// differs at most in the sign of a zero result).
     #[inline]
     pub(crate) fn velocity(&self, a: &Motion, b: &Motion) -> Real {
-        self.lin.dot(b.v - a.v) + self.ang_a.dot(a.w) + self.ang_b.dot(b.w)
+        let angular = self.ang_a.dot(a.w);
+        if self.angular {
+            return angular + self.ang_b.dot(b.w);
+        }
+        self.lin.dot(b.v - a.v) + angular + self.ang_b.dot(b.w)
     }
 
+    /// Applies `lambda` along the row (`-` to A, `+` to B); an angular row changes no
+    /// linear velocity.
     #[inline]
     pub(crate) fn apply(&self, a: &mut Motion, b: &mut Motion, lambda: Real) {
-        a.v -= self.lin * (a.inv_m * lambda);
+        if !self.angular {
+            a.v -= self.lin * (a.inv_m * lambda);
+            b.v += self.lin * (b.inv_m * lambda);
+        }
         a.w += self.ia * lambda;
-        b.v += self.lin * (b.inv_m * lambda);
         b.w += self.ib * lambda;
     }
 
@@ -269,10 +284,30 @@ impl Block {
     }
 
     /// One block update of `rows` (the block's rows), with the same soft feedback as
-    /// [`Row::solve`] gives an equality row.
+    /// [`Row::solve`] gives an equality row. Dispatches on the block size to a loop of fixed
+    /// length, which the compiler unrolls (no per-row loop bookkeeping or index checks).
     pub fn solve(
         &self,
         rows: &mut [Row],
+        a: &mut Motion,
+        b: &mut Motion,
+        soft: Softness,
+        use_bias: bool,
+    ) {
+        match rows {
+            [r0, r1, r2] => self.solve_n([r0, r1, r2], a, b, soft, use_bias),
+            [r0, r1] => self.solve_n([r0, r1], a, b, soft, use_bias),
+            [r0] => self.solve_n([r0], a, b, soft, use_bias),
+            _ => {}
+        }
+    }
+
+    /// [`Block::solve`] on `N` rows: `λ = -K⁻¹ (J v + bias)·mass_scale - impulse·impulse_scale`,
+    /// with the entries past `N` zero (and `K⁻¹` padded with the identity).
+    #[inline(always)]
+    fn solve_n<const N: usize>(
+        &self,
+        mut rows: [&mut Row; N],
         a: &mut Motion,
         b: &mut Motion,
         soft: Softness,
@@ -294,6 +329,115 @@ impl Block {
         for (i, r) in rows.iter_mut().enumerate() {
             r.impulse += lambda[i];
             r.apply(a, b, lambda[i]);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn body(seed: Real) -> SolverBody {
+        let v = |k: Real| Vec3::new(seed * k, 0.3 - seed * k, 0.7 * k - seed);
+        SolverBody {
+            v: v(1.3),
+            w: v(-0.9),
+            dp: Vec3::ZERO,
+            dq: Vec3::ZERO,
+            inv_m: 0.5 + seed,
+            inv_i: Mat3::from_diagonal(Vec3::new(1.0 + seed, 2.0 - seed, 1.5)),
+            dynamic: true,
+        }
+    }
+
+    /// The full `J v` and impulse update, linear terms included (the reference).
+    fn velocity_ref(r: &Row, a: &Motion, b: &Motion) -> Real {
+        r.lin.dot(b.v - a.v) + r.ang_a.dot(a.w) + r.ang_b.dot(b.w)
+    }
+
+    fn apply_ref(r: &Row, a: &mut Motion, b: &mut Motion, lambda: Real) {
+        a.v -= r.lin * (a.inv_m * lambda);
+        a.w += r.ia * lambda;
+        b.v += r.lin * (b.inv_m * lambda);
+        b.w += r.ib * lambda;
+    }
+
+    /// An angular row (zero `lin`) skips only terms that are zero: its velocity and impulse
+    /// update equal the full formula bit for bit (nonzero results); a linear row is not
+    /// marked, and a refresh re-marks the row.
+    #[test]
+    fn angular_rows_skip_only_zero_terms() {
+        let (sa, sb) = (body(0.21), body(0.67));
+        let axis = Vec3::new(0.3, -0.8, 0.52).normalize();
+        let mut row = Row::new(9, [Vec3::ZERO, -axis, axis], 0.01, RowKind::Equality, 0.0);
+        assert!(row.angular);
+        row.finish(&sa, &sb);
+        let (a, b) = (Motion::of(&sa), Motion::of(&sb));
+        let v = row.velocity(&a, &b);
+        assert_ne!(v, 0.0);
+        assert_eq!(v.to_bits(), velocity_ref(&row, &a, &b).to_bits());
+        let (mut a1, mut b1, mut a2, mut b2) = (a, b, a, b);
+        row.apply(&mut a1, &mut b1, 0.37);
+        apply_ref(&row, &mut a2, &mut b2, 0.37);
+        assert_eq!((a1.v, a1.w, b1.v, b1.w), (a2.v, a2.w, b2.v, b2.w));
+        // A refresh to a linear Jacobian clears the mark, and the linear terms count.
+        let lin = Vec3::new(0.0, 1.0, 0.0);
+        row.set([lin, Vec3::X, Vec3::Y], 0.0);
+        assert!(!row.angular);
+        row.finish(&sa, &sb);
+        assert_eq!(
+            row.velocity(&a, &b).to_bits(),
+            velocity_ref(&row, &a, &b).to_bits()
+        );
+    }
+
+    /// `Block::solve` on two and three rows equals the coupled update written out with the
+    /// full row formulas: `λ = -K⁻¹ (J v + bias)·mass_scale - impulse·impulse_scale`.
+    #[test]
+    fn block_solve_matches_the_coupled_formula() {
+        let (sa, sb) = (body(0.13), body(0.44));
+        let (ra, rb) = (Vec3::new(0.4, -0.2, 0.1), Vec3::new(-0.3, 0.25, 0.2));
+        let soft = Softness::new(60.0, 2.0, 1.0 / 240.0);
+        for n in [2, 3] {
+            for use_bias in [true, false] {
+                let mut rows: Vec<Row> = (0..n)
+                    .map(|i| {
+                        let axis = [Vec3::X, Vec3::Y, Vec3::Z][i];
+                        let j = [axis, -ra.cross(axis), rb.cross(axis)];
+                        let mut r = Row::new(i as u8, j, 0.01 * i as Real, RowKind::Equality, 0.0);
+                        r.impulse = 0.1 * (i as Real + 1.0);
+                        r
+                    })
+                    .collect();
+                let mut block = Block::new(0, n);
+                block.update(&mut rows, &sa, &sb);
+                assert!(block.valid);
+                let mut expected = rows.clone();
+                let (mut a, mut b) = (Motion::of(&sa), Motion::of(&sb));
+                let (mut ea, mut eb) = (a, b);
+                block.solve(&mut rows, &mut a, &mut b, soft, use_bias);
+                // The reference.
+                let (ms, is) = if use_bias {
+                    (soft.mass_scale, soft.impulse_scale)
+                } else {
+                    (1.0, 0.0)
+                };
+                let (mut rhs, mut acc) = (Vec3::ZERO, Vec3::ZERO);
+                for (i, r) in expected.iter().enumerate() {
+                    let bias = if use_bias { soft.bias_rate * r.c } else { 0.0 };
+                    rhs[i] = velocity_ref(r, &ea, &eb) + bias;
+                    acc[i] = r.impulse;
+                }
+                let lambda = -(block.inv_k * rhs) * ms - acc * is;
+                for (i, r) in expected.iter_mut().enumerate() {
+                    r.impulse += lambda[i];
+                    apply_ref(r, &mut ea, &mut eb, lambda[i]);
+                }
+                assert_eq!((a.v, a.w, b.v, b.w), (ea.v, ea.w, eb.v, eb.w), "{n} rows");
+                for (r, e) in rows.iter().zip(&expected) {
+                    assert_eq!(r.impulse.to_bits(), e.impulse.to_bits());
+                }
+            }
         }
     }
 }
