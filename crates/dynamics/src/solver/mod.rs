@@ -23,7 +23,9 @@ pub(crate) mod contact_simd;
 pub(crate) mod joints;
 pub(crate) mod rows;
 pub(crate) mod sequential;
+pub(crate) mod soft_stages;
 pub(crate) mod soft_step;
+pub(crate) mod stages;
 mod timing;
 
 pub use timing::StepTimings;
@@ -36,6 +38,8 @@ pub(crate) struct SolverScratch {
     pub contacts: contact::ContactScratch,
     /// Per-step constants of the moving bodies' integration.
     pub terms: Vec<crate::integrate::BodyTerms>,
+    /// The soft step's stage list (module `stages`).
+    pub stages: stages::StageList<soft_stages::SoftStage>,
 }
 
 use crate::body_set::BodySet;
