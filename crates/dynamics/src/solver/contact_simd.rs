@@ -261,6 +261,9 @@ pub(crate) struct WideScratch {
     pub ranges: Vec<Range<usize>>,
     /// The overflow colour, as a range of the scalar constraints.
     pub overflow: Range<usize>,
+    /// The colour-order index of the constraint in each lane of `cons` (`NONE` for
+    /// padding), assigned before the lanes are built.
+    pub members: Vec<[usize; LANES]>,
 }
 
 /// Raw access to the solver bodies while one colour is solved.

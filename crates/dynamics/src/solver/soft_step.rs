@@ -44,6 +44,7 @@ pub(crate) fn step(ctx: &mut StepContext) {
     let terms = &mut ctx.scratch.terms;
     integrate::prepare_terms(ctx.set, ctx.bodies, ctx.gravity, h, ctx.gyroscopic, terms);
     let simd = p.simd;
+    let threads = thread_count(ctx.parallel);
     contact::prepare(
         ctx.manifolds,
         ctx.set,
@@ -52,6 +53,7 @@ pub(crate) fn step(ctx: &mut StepContext) {
         soft,
         static_soft,
         simd,
+        threads > 1,
         scratch,
     );
     let rows = &mut *ctx.joint_scratch;
@@ -90,7 +92,6 @@ pub(crate) fn step(ctx: &mut StepContext) {
     };
     lap(&mut t, &mut ctx.timings.prepare);
 
-    let threads = thread_count(ctx.parallel);
     soft_stages::run(
         plan, threads, consts, ctx.set, ctx.bodies, terms, scratch, rows, ctx.joints,
     );

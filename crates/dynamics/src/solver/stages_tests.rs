@@ -86,7 +86,11 @@ fn relax(threads: usize, stages: usize) -> Vec<f64> {
         list.push(s, block_count(n, 97));
     }
     let step = |s: usize, blk: usize, blocks: usize| {
-        let (src, dst) = if s.is_multiple_of(2) { (&a, &b) } else { (&b, &a) };
+        let (src, dst) = if s.is_multiple_of(2) {
+            (&a, &b)
+        } else {
+            (&b, &a)
+        };
         let get = |i: usize| f64::from_bits(src[i].load(Ordering::Relaxed));
         for i in block_range(n, blocks, blk) {
             let (l, r) = (get(i.saturating_sub(1)), get((i + 1).min(n - 1)));
