@@ -170,8 +170,8 @@ impl WideConstraint {
 /// The lanes are assigned first (serially, cheap), then the wide constraints are built, on
 /// rayon in chunks of [`BUILD_CHUNK`] when `parallel` and the pool has more than one thread:
 /// each wide constraint is written only from its own lanes, so the result is the same bits
-/// whatever the thread count. The constraint preparation was a quarter of the serial work of
-/// a two-thread step.
+/// whatever the thread count. The constraint preparation was half of what stayed serial in a
+/// two-thread "1000 stack" step.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn fill(
     out: &mut WideScratch,
