@@ -244,6 +244,7 @@ pub(crate) fn fill(
 }
 
 /// Wide constraints per rayon task of [`fill`].
+#[cfg_attr(not(feature = "parallel"), allow(dead_code))]
 pub(crate) const BUILD_CHUNK: usize = 32;
 
 /// Runs `build` over chunks of `ws` and `ms` on rayon; false (nothing done) when there is
