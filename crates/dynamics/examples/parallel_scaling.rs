@@ -5,7 +5,9 @@
 //! thread count, checked here through the state hashes), so each step gives one ratio of
 //! wall times taken within milliseconds of each other. Prints the medians of the per-step
 //! times, the median of the per-step ratios, and the whole-step and per-stage (solver,
-//! narrowphase) ratios.
+//! narrowphase) ratios. As a control of how much of a second core the machine gives, each
+//! step is followed by the same embarrassingly parallel loop (sines, about 1 ms on one
+//! thread) in both pools: its median ratio is the speed-up the machine allows at that time.
 //!
 //! `cargo run --release -p carom-dynamics --example parallel_scaling -- [scene 1–8] [steps]
 //! [threads]`
@@ -19,6 +21,16 @@ fn median(v: &mut [f64]) -> f64 {
         return f64::NAN;
     }
     v[v.len() / 2]
+}
+
+/// The control workload: a parallel sum of sines (no allocation, no shared writes).
+fn control() -> f64 {
+    use rayon::prelude::*;
+    (0..200_000u32)
+        .into_par_iter()
+        .with_min_len(4096)
+        .map(|i| (i as f64 * 1e-3).sin())
+        .sum()
 }
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -42,6 +54,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     // Per side: whole step, solver (+ islands), narrowphase, per step.
     let mut times = [[vec![], vec![], vec![]], [vec![], vec![], vec![]]];
     let mut ratios = vec![];
+    let mut controls = vec![];
     for _ in 0..steps {
         let mut wall = [0.0; 2];
         for side in 0..2 {
@@ -54,6 +67,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             times[side][2].push(t.narrowphase.as_secs_f64() * 1e3);
         }
         ratios.push(wall[0] / wall[1]);
+        let mut c = [0.0; 2];
+        for side in 0..2 {
+            let t0 = Instant::now();
+            std::hint::black_box(pools[side].install(control));
+            c[side] = t0.elapsed().as_secs_f64();
+        }
+        controls.push(c[0] / c[1]);
     }
     let same = worlds[0].dynamics().state_hash() == worlds[1].dynamics().state_hash();
     let m: Vec<[f64; 3]> = times
@@ -63,7 +83,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     println!(
         "scene {number}, {steps} steps, 1 vs {threads} threads (medians, ms/step): \
          step {:.3} vs {:.3} = {:.2}x, solver {:.3} vs {:.3} = {:.2}x, narrowphase {:.3} vs \
-         {:.3} = {:.2}x; median per-step ratio {:.2}x; bit-identical: {same}",
+         {:.3} = {:.2}x; median per-step ratio {:.2}x; control {:.2}x; bit-identical: {same}",
         m[0][0],
         m[1][0],
         m[0][0] / m[1][0],
@@ -74,6 +94,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         m[1][2],
         m[0][2] / m[1][2],
         median(&mut ratios),
+        median(&mut controls),
     );
     if !same {
         return Err("the two runs differ".into());
