@@ -139,22 +139,37 @@ pub(crate) fn integrate_velocities(
         if t.flags & DYNAMIC == 0 {
             continue;
         }
-        let b = &mut bodies[t.slot];
-        b.v += t.dv;
-        b.w += t.dw;
-        if t.flags & GYROSCOPIC != 0 && b.w != Vec3::ZERO && t.has_inertia() {
-            b.w = gyroscopic_implicit(rotation[t.slot], t.inertia, b.w, h);
-        }
-        if t.flags & DAMP_V != 0 {
-            b.v *= t.damp_v;
-        }
-        if t.flags & DAMP_W != 0 {
-            b.w *= t.damp_w;
-        }
+        integrate_velocity(t, rotation[t.slot], &mut bodies[t.slot], h);
+    }
+}
+
+/// [`integrate_velocities`] of one body: `b` is the body of `t` (slot [`BodyTerms::slot`]),
+/// `q` its rotation; does nothing unless the body is dynamic.
+#[inline]
+pub(crate) fn integrate_velocity(t: &mut BodyTerms, q: Quat, b: &mut SolverBody, h: Real) {
+    if t.flags & DYNAMIC == 0 {
+        return;
+    }
+    b.v += t.dv;
+    b.w += t.dw;
+    if t.flags & GYROSCOPIC != 0 && b.w != Vec3::ZERO && t.has_inertia() {
+        b.w = gyroscopic_implicit(q, t.inertia, b.w, h);
+    }
+    if t.flags & DAMP_V != 0 {
+        b.v *= t.damp_v;
+    }
+    if t.flags & DAMP_W != 0 {
+        b.w *= t.damp_w;
     }
 }
 
 impl BodyTerms {
+    /// The body's slot.
+    #[inline]
+    pub(crate) fn slot(&self) -> usize {
+        self.slot
+    }
+
     /// Makes `inertia` the body-space inertia on first use; false (and no gyroscopic term
     /// from then on) when the local inverse inertia is singular or invalid.
     #[inline]
@@ -252,6 +267,7 @@ pub(crate) fn integrate_positions(
 /// speed clamp of [`clamp_speeds`] (dynamic bodies), then the pose update of
 /// [`integrate_positions`] with the deltas tracked in `dp`/`dq` — both in one pass over the
 /// moving bodies, in the same order per body as the two separate passes, so the same bits.
+#[cfg(test)]
 pub(crate) fn clamp_and_integrate_positions(
     terms: &[BodyTerms],
     set: &mut BodySet,
@@ -260,23 +276,36 @@ pub(crate) fn clamp_and_integrate_positions(
 ) {
     for t in terms {
         let i = t.slot;
-        let b = &mut bodies[i];
-        if t.flags & DYNAMIC != 0 {
-            let v2 = b.v.length_squared();
-            if v2 > t.max_v_sq {
-                b.v *= t.max_v / v2.sqrt();
-            }
-            let w2 = b.w.length_squared();
-            if w2 > t.max_w_sq {
-                b.w *= t.max_w / w2.sqrt();
-            }
-        }
-        let (v, w) = (b.v, b.w);
-        set.position[i] += v * h;
-        set.rotation[i] = integrate_rotation(set.rotation[i], w, h);
-        b.dp += v * h;
-        b.dq += w * h;
+        let (p, q) = (&mut set.position[i], &mut set.rotation[i]);
+        clamp_and_integrate_position(t, p, q, &mut bodies[i], h);
     }
+}
+
+/// [`clamp_and_integrate_positions`] of one body: `b` is the body of `t` (slot
+/// [`BodyTerms::slot`]), `p` and `q` its position and rotation.
+#[inline]
+pub(crate) fn clamp_and_integrate_position(
+    t: &BodyTerms,
+    p: &mut Vec3,
+    q: &mut Quat,
+    b: &mut SolverBody,
+    h: Real,
+) {
+    if t.flags & DYNAMIC != 0 {
+        let v2 = b.v.length_squared();
+        if v2 > t.max_v_sq {
+            b.v *= t.max_v / v2.sqrt();
+        }
+        let w2 = b.w.length_squared();
+        if w2 > t.max_w_sq {
+            b.w *= t.max_w / w2.sqrt();
+        }
+    }
+    let (v, w) = (b.v, b.w);
+    *p += v * h;
+    *q = integrate_rotation(*q, w, h);
+    b.dp += v * h;
+    b.dq += w * h;
 }
 
 /// Copies velocities back, refreshes world inertias and clears forces.

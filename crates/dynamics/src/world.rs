@@ -32,8 +32,9 @@ pub struct WorldParams {
     /// (Bullet's `computeGyroscopicImpulseImplicit_Body`), which keeps fast, thin spinning
     /// bodies stable.
     pub gyroscopic: bool,
-    /// Solve large colours in parallel (with the `parallel` feature). Results are
-    /// bit-identical either way.
+    /// Use the current rayon pool's threads in the solver (with the `parallel` feature): the
+    /// soft step's stages and the building of its constraints, or the large colours of
+    /// sequential impulses. Results are bit-identical either way.
     pub parallel: bool,
 }
 

@@ -139,6 +139,30 @@ pub(crate) fn solve_coloured<C, F>(
     }
 }
 
+/// Runs `f` on the constraints `range` of `cons`, one after another, each in place on its
+/// dynamic bodies as in [`solve_coloured`]: one block of a colour (or the whole overflow
+/// colour) in the stage-parallel soft step (module `stages`).
+///
+/// # Safety
+/// `cons` points to at least `range.end` constraints and `bodies` to `len` solver bodies;
+/// during the call no other live reference touches those constraints or their dynamic bodies
+/// (true for disjoint blocks of one colour, or for a block that runs alone).
+pub(crate) unsafe fn solve_range<C, F>(
+    cons: *mut C,
+    range: Range<usize>,
+    bodies: *mut SolverBody,
+    len: usize,
+    f: &F,
+) where
+    C: PairConstraint,
+    F: Fn(&mut C, &mut SolverBody, &mut SolverBody),
+{
+    let shared = SharedBodies { ptr: bodies, len };
+    for i in range {
+        shared.with_pair(&mut *cons.add(i), f);
+    }
+}
+
 /// Raw access to the solver bodies for the constraints of one colour.
 #[derive(Clone, Copy)]
 struct SharedBodies {

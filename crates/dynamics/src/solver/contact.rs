@@ -191,7 +191,8 @@ pub(crate) struct ContactScratch {
 /// overflow colour into `scratch.cons`. `impulse_in` scales the stored impulses (per-step
 /// units) to the solver's units (0 disables warm start). The manifolds are coloured first
 /// and each constraint is built once, at its place: no reordering copy of the (large)
-/// constraints. Allocates only when a buffer of `scratch` must grow.
+/// constraints. Allocates only when a buffer of `scratch` must grow. With `parallel` (and
+/// SIMD) the wide constraints are built on rayon (`contact_simd::fill`), with the same bits.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn prepare(
     manifolds: &[ContactManifold],
@@ -201,6 +202,7 @@ pub(crate) fn prepare(
     soft: Softness,
     static_soft: Softness,
     simd: bool,
+    parallel: bool,
     scratch: &mut ContactScratch,
 ) {
     let ContactScratch {
@@ -245,7 +247,8 @@ pub(crate) fn prepare(
     };
     if simd {
         let points = |k: usize| manifolds[selected[order[k]]].points().len();
-        super::contact_simd::fill(wide, cons, &colouring.ranges, bodies, points, make);
+        let ranges = &colouring.ranges;
+        super::contact_simd::fill(wide, cons, ranges, bodies, points, make, parallel);
     } else {
         cons.clear();
         cons.extend((0..order.len()).map(|k| {

@@ -16,7 +16,9 @@
 //! physics; the grouping depends only on the colour order, never on the thread count.
 //! The lane type is selected from [`Real`] in one place ([`W`]): `f32x4` or `f64x4`.
 
+#[cfg(test)]
 use super::coloring::solve_coloured;
+#[cfg(test)]
 use super::contact::ContactConstraint;
 use super::SolverBody;
 use crate::contact::MAX_MANIFOLD_POINTS;
@@ -187,13 +189,16 @@ pub(crate) struct WideBody {
 /// transposes, which leave exactly the twelve lane vectors (`v.x … dq.z`).
 #[inline(always)]
 fn gather(bodies: &[SolverBody], slots: &[usize; LANES], inv_m: W) -> WideBody {
-    let rows = slots.map(|s| {
+    let row = |s: usize| {
         if s == NONE {
             [[0.0; LANES]; 3]
         } else {
             bodies[s].state()
         }
-    });
+    };
+    // Not `slots.map`: that call was left out of line in the stage executor (module
+    // `soft_stages`), 100 M instructions in 60 steps of "1000 stack".
+    let rows = [row(slots[0]), row(slots[1]), row(slots[2]), row(slots[3])];
     let t = |k: usize| W::transpose(rows.map(|r| W::new(r[k])));
     let ([vx, vy, vz, wx], [wy, wz, px, py], [pz, qx, qy, qz]) = (t(0), t(1), t(2));
     WideBody {
@@ -258,6 +263,9 @@ pub(crate) struct WideScratch {
     pub ranges: Vec<Range<usize>>,
     /// The overflow colour, as a range of the scalar constraints.
     pub overflow: Range<usize>,
+    /// The colour-order index of the constraint in each lane of `cons` (`NONE` for
+    /// padding), assigned before the lanes are built.
+    pub members: Vec<[usize; LANES]>,
 }
 
 /// Raw access to the solver bodies while one colour is solved.
@@ -295,9 +303,39 @@ impl Bodies {
     }
 }
 
+/// Runs `f` (where `active` holds) on the wide constraints `range` of `cons`, one after
+/// another: one block of a colour in the stage-parallel soft step (module `stages`).
+///
+/// # Safety
+/// `cons` points to at least `range.end` wide constraints and `bodies` to `len` solver
+/// bodies; during the call no other live reference touches those constraints or their
+/// dynamic bodies (true for disjoint blocks of one colour). Not inlined, so each pass is one
+/// function in which the gather and scatter are inlined (inlined into the caller's larger
+/// stage executor they were not, which cost 5 % of the solver's instructions).
+#[inline(never)]
+pub(crate) unsafe fn solve_range<F, A>(
+    cons: *mut WideConstraint,
+    range: Range<usize>,
+    bodies: *mut SolverBody,
+    len: usize,
+    f: &F,
+    active: &A,
+) where
+    F: Fn(&mut WideConstraint, &mut WideBody, &mut WideBody),
+    A: Fn(&WideConstraint) -> bool,
+{
+    let shared = Bodies { ptr: bodies, len };
+    for i in range {
+        shared.run(&mut *cons.add(i), f, active);
+    }
+}
+
 /// Runs `wide_fn` on every wide constraint, colour by colour (in parallel inside a colour of
 /// at least `min_batch` constraints when `parallel`), then `scalar_fn` on the overflow
-/// colour of `cons`. Same bits whatever the thread count; no allocation.
+/// colour of `cons`. Same bits whatever the thread count; no allocation. The soft step runs
+/// the colours through its stage list instead (module `soft_stages`, [`solve_range`]); this
+/// driver is the tests' reference.
+#[cfg(test)]
 pub(crate) fn solve<F, S>(
     wide: &mut WideScratch,
     cons: &mut [ContactConstraint],
@@ -323,6 +361,7 @@ pub(crate) fn solve<F, S>(
 
 /// [`solve`] on the wide constraints for which `active` holds; the others are skipped
 /// without gathering their bodies (e.g. restitution on constraints without restitution).
+#[cfg(test)]
 pub(crate) fn solve_active<A, F, S>(
     wide: &mut WideScratch,
     cons: &mut [ContactConstraint],
@@ -355,7 +394,7 @@ pub(crate) fn solve_active<A, F, S>(
     solve_coloured(cons, &[overflow], bodies, false, min_batch, scalar_fn);
 }
 
-#[cfg(feature = "parallel")]
+#[cfg(all(test, feature = "parallel"))]
 fn solve_parallel<F, A>(chunk: &mut [WideConstraint], shared: Bodies, f: &F, active: &A) -> bool
 where
     F: Fn(&mut WideConstraint, &mut WideBody, &mut WideBody) + Sync,
@@ -374,7 +413,7 @@ where
     true
 }
 
-#[cfg(not(feature = "parallel"))]
+#[cfg(all(test, not(feature = "parallel")))]
 fn solve_parallel<F, A>(_: &mut [WideConstraint], _: Bodies, _: &F, _: &A) -> bool {
     false
 }

@@ -261,66 +261,108 @@ impl WideConstraint {
 /// lane, so mixing a one-point lane with a four-point lane wastes three points of work. The
 /// constraints of a colour share no dynamic body, so their order inside the colour does not
 /// change any result (and depends only on the colour order, not on the thread count).
+///
+/// The lanes are assigned first (serially, cheap), then the wide constraints are built, on
+/// rayon in chunks of [`BUILD_CHUNK`] when `parallel` and the pool has more than one thread:
+/// each wide constraint is written only from its own lanes, so the result is the same bits
+/// whatever the thread count. The constraint preparation was half of what stayed serial in a
+/// two-thread "1000 stack" step.
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn fill(
     out: &mut WideScratch,
     cons: &mut Vec<ContactConstraint>,
     ranges: &[Range<usize>],
     bodies: &[SolverBody],
     points: impl Fn(usize) -> usize,
-    mut make: impl FnMut(usize, &mut ContactConstraint, bool),
+    make: impl Fn(usize, &mut ContactConstraint, bool) + Sync,
+    parallel: bool,
 ) {
     cons.clear();
     out.ranges.clear();
+    out.members.clear();
     let Some((overflow, colours)) = ranges.split_last() else {
         out.cons.clear();
         out.overflow = 0..0;
         return;
     };
     let bucket = |k: usize| points(k).clamp(1, MAX_MANIFOLD_POINTS);
-    // One constraint at a time is prepared here and written into its lane.
-    let mut c = ContactConstraint::EMPTY;
-    let mut inputs = RowInputs::default();
-    let mut used = 0;
     for r in colours {
-        let start = used;
-        // Lane of the next constraint in the current wide constraint `used - 1`.
+        let start = out.members.len();
+        // Lane of the next constraint in the last wide constraint.
         let mut lane = LANES;
         for count in (1..=MAX_MANIFOLD_POINTS).rev() {
             for k in r.clone().filter(|&k| bucket(k) == count) {
                 if lane == LANES {
-                    if used == out.cons.len() {
-                        out.cons.push(WideConstraint::empty());
-                    }
-                    out.cons[used].len = 0;
-                    used += 1;
+                    out.members.push([NONE; LANES]);
                     lane = 0;
                 }
-                let w = &mut out.cons[used - 1];
-                make(k, &mut c, false);
-                w.len = w.len.max(c.len);
-                w.set_lane(lane, Some(&c), bodies, &mut inputs);
+                let last = out.members.len() - 1;
+                out.members[last][lane] = k;
                 lane += 1;
-                if lane == LANES {
-                    w.finish(&inputs);
-                }
             }
         }
-        if used > start && lane < LANES {
-            let w = &mut out.cons[used - 1];
-            for l in lane..LANES {
-                w.set_lane(l, None, bodies, &mut inputs);
+        out.ranges.push(start..out.members.len());
+    }
+    let used = out.members.len();
+    if out.cons.len() < used {
+        out.cons.resize_with(used, WideConstraint::empty);
+    }
+    out.cons.truncate(used);
+    // One chunk of wide constraints; one constraint at a time is prepared and written into
+    // its lane.
+    let build = |ws: &mut [WideConstraint], ms: &[[usize; LANES]]| {
+        let mut c = ContactConstraint::EMPTY;
+        let mut inputs = RowInputs::default();
+        for (w, m) in ws.iter_mut().zip(ms) {
+            w.len = 0;
+            for (lane, &k) in m.iter().enumerate() {
+                if k == NONE {
+                    w.set_lane(lane, None, bodies, &mut inputs);
+                } else {
+                    make(k, &mut c, false);
+                    w.len = w.len.max(c.len);
+                    w.set_lane(lane, Some(&c), bodies, &mut inputs);
+                }
             }
             w.finish(&inputs);
         }
-        out.ranges.push(start..used);
+    };
+    let (ws, ms) = (&mut out.cons[..], &out.members[..]);
+    if !(parallel && build_parallel(ws, ms, &build)) {
+        build(ws, ms);
     }
-    out.cons.truncate(used);
     cons.extend(overflow.clone().map(|k| {
         let mut c = ContactConstraint::EMPTY;
         make(k, &mut c, true);
         c
     }));
     out.overflow = 0..cons.len();
+}
+
+/// Wide constraints per rayon task of [`fill`].
+#[cfg_attr(not(feature = "parallel"), allow(dead_code))]
+pub(crate) const BUILD_CHUNK: usize = 32;
+
+/// Runs `build` over chunks of `ws` and `ms` on rayon; false (nothing done) when there is
+/// one thread or too little work.
+#[cfg(feature = "parallel")]
+fn build_parallel<F>(ws: &mut [WideConstraint], ms: &[[usize; LANES]], build: &F) -> bool
+where
+    F: Fn(&mut [WideConstraint], &[[usize; LANES]]) + Sync,
+{
+    use rayon::prelude::*;
+    if rayon::current_num_threads() < 2 || ws.len() < 2 * BUILD_CHUNK {
+        return false;
+    }
+    ws.par_chunks_mut(BUILD_CHUNK)
+        .zip(ms.par_chunks(BUILD_CHUNK))
+        .for_each(|(w, m)| build(w, m));
+    true
+}
+
+#[cfg(not(feature = "parallel"))]
+fn build_parallel<F>(_: &mut [WideConstraint], _: &[[usize; LANES]], _: &F) -> bool {
+    false
 }
 
 /// Groups already prepared scalar constraints (`cons`, in colour order with colour `ranges`,
@@ -337,17 +379,15 @@ pub(crate) fn build(
     let mut scratch = Vec::new();
     let points = |k: usize| cons[k].len;
     let Some((overflow, colours)) = ranges.split_last() else {
-        fill(out, &mut scratch, ranges, bodies, points, |k, c, _| {
-            *c = cons[k].clone()
-        });
+        let make = |k: usize, c: &mut ContactConstraint, _: bool| *c = cons[k].clone();
+        fill(out, &mut scratch, ranges, bodies, points, make, false);
         return;
     };
     // The overflow colour is left out of the lanes and kept in `cons` by range.
     let mut rs: Vec<Range<usize>> = colours.to_vec();
     rs.push(overflow.start..overflow.start);
-    fill(out, &mut scratch, &rs, bodies, points, |k, c, _| {
-        *c = cons[k].clone()
-    });
+    let make = |k: usize, c: &mut ContactConstraint, _: bool| *c = cons[k].clone();
+    fill(out, &mut scratch, &rs, bodies, points, make, false);
     out.overflow = overflow.clone();
 }
 

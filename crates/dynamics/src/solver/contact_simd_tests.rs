@@ -307,7 +307,7 @@ fn fill_writes_every_lane_and_overwrites_stale_ones() {
         (0, vec![Range { start: 0, end: 0 }]),
     ] {
         let (bodies, cons) = scene(&mut rng, count);
-        let made = std::cell::Cell::new(0);
+        let made = std::sync::atomic::AtomicUsize::new(0);
         let points = |k: usize| cons[k].len;
         fill(
             &mut wide,
@@ -316,11 +316,13 @@ fn fill_writes_every_lane_and_overwrites_stale_ones() {
             &bodies,
             points,
             |k, c, _| {
-                made.set(made.get() + 1);
+                made.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
                 *c = cons[k].clone();
             },
+            false,
         );
-        assert_eq!(made.get(), count, "each constraint is prepared once");
+        let made = made.load(std::sync::atomic::Ordering::Relaxed);
+        assert_eq!(made, count, "each constraint is prepared once");
         let (overflow, colours) = ranges.split_last().unwrap();
         assert_eq!(wide.ranges.len(), colours.len());
         assert_eq!(
@@ -386,6 +388,7 @@ fn store_matches_the_scalar_store() {
         &bodies,
         points,
         |k, c, _| *c = cons[k].clone(),
+        false,
     );
     let (mut m_wide, mut m_scalar) = (manifolds.clone(), manifolds);
     store(&wide, &mut m_wide, 4.0);

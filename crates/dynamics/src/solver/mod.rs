@@ -13,7 +13,9 @@
 //!
 //! Contacts are graph-coloured (module `coloring`): constraints of one colour share no dynamic
 //! body, so a colour may be solved in parallel with rayon and still give the same bits as a
-//! sequential solve (each constraint reads and writes only its own two bodies).
+//! sequential solve (each constraint reads and writes only its own two bodies). The soft step
+//! runs all its substeps in one parallel region that walks a list of stages (modules `stages`
+//! and `soft_stages`, after Box2D v3's solver stages).
 
 #[cfg(test)]
 mod alloc_tests;
@@ -23,7 +25,9 @@ pub(crate) mod contact_simd;
 pub(crate) mod joints;
 pub(crate) mod rows;
 pub(crate) mod sequential;
+pub(crate) mod soft_stages;
 pub(crate) mod soft_step;
+pub(crate) mod stages;
 mod timing;
 
 pub use timing::StepTimings;
@@ -36,6 +40,8 @@ pub(crate) struct SolverScratch {
     pub contacts: contact::ContactScratch,
     /// Per-step constants of the moving bodies' integration.
     pub terms: Vec<crate::integrate::BodyTerms>,
+    /// The soft step's stage list (module `stages`).
+    pub stages: stages::StageList<soft_stages::SoftStage>,
 }
 
 use crate::body_set::BodySet;
@@ -88,7 +94,9 @@ pub struct SolverParams {
     pub restitution_threshold: Real,
     /// Apply last step's impulses first.
     pub warm_starting: bool,
-    /// Smallest colour solved in parallel (when the `parallel` feature is on).
+    /// Smallest colour, in scalar constraints, solved in parallel (when the `parallel`
+    /// feature is on): the soft step makes a smaller colour one block of its stage list
+    /// (module `soft_stages`), sequential impulses solve it on the calling thread.
     pub parallel_min_batch: usize,
     /// Soft step: solve the contacts of each colour four at a time with SIMD lanes
     /// (module `contact_simd`, after Box2D v3); the overflow colour stays scalar. Both paths

@@ -8,15 +8,18 @@
 //! restitution pass. Constraint errors follow the substeps through the position deltas
 //! (`dp`, `dq`) accumulated since the start of the step. Impulses are per substep inside and
 //! stored per step outside.
+//!
+//! Everything from the first substep to the restitution pass is one list of stages (module
+//! `stages`, Box2D's `b2SolverStage`s) run in one parallel region: the body stages in blocks
+//! of bodies, each contact colour in blocks of constraints, the joints and the overflow
+//! colour as single blocks (module `soft_stages`).
 
-use super::coloring::solve_coloured;
-use super::contact::ContactConstraint;
-use super::contact_simd::WideScratch;
+use super::soft_stages::{self, Pass, SoftStage};
+use super::stages::thread_count;
 use super::timing::lap;
-use super::{contact, contact_simd, joints, Softness, SolverBody, StepContext};
+use super::{contact, contact_simd, joints, Softness, StepContext};
 use crate::integrate;
 use carom_collision::math::{Real, Vec3};
-use std::ops::Range;
 use std::time::Instant;
 
 /// Runs one step of the soft-step solver.
@@ -41,6 +44,7 @@ pub(crate) fn step(ctx: &mut StepContext) {
     let terms = &mut ctx.scratch.terms;
     integrate::prepare_terms(ctx.set, ctx.bodies, ctx.gravity, h, ctx.gyroscopic, terms);
     let simd = p.simd;
+    let threads = thread_count(ctx.parallel);
     contact::prepare(
         ctx.manifolds,
         ctx.set,
@@ -49,102 +53,69 @@ pub(crate) fn step(ctx: &mut StepContext) {
         soft,
         static_soft,
         simd,
+        threads > 1,
         scratch,
-    );
-    let (cons, ranges, wide) = (
-        &mut scratch.cons,
-        &scratch.colouring.ranges[..],
-        &mut scratch.wide,
     );
     let rows = &mut *ctx.joint_scratch;
     joints::prepare(rows, ctx.joints, ctx.set, ctx.bodies, h, warm);
-    let joint_soft = Softness::new(p.joint_hertz, p.joint_damping_ratio, h);
-    let (par, min) = (ctx.parallel, p.parallel_min_batch);
-    let max_push = p.max_push_velocity;
+
+    let plan = &mut ctx.scratch.stages;
+    let colours = if simd {
+        &scratch.wide.ranges[..]
+    } else {
+        let r = &scratch.colouring.ranges[..];
+        &r[..r.len().saturating_sub(1)]
+    };
+    let overflow = if simd {
+        scratch.wide.overflow.len()
+    } else {
+        scratch.colouring.ranges.last().map_or(0, |r| r.len())
+    };
+    let shape = soft_stages::Shape {
+        substeps: n,
+        warm_starting: p.warm_starting,
+        joints: !rows.joints.is_empty(),
+        colours,
+        lanes: if simd { contact_simd::LANES } else { 1 },
+        overflow,
+        bodies: terms.len(),
+        min_batch: p.parallel_min_batch,
+    };
+    soft_stages::plan(plan, &shape);
+    let consts = soft_stages::Consts {
+        h,
+        inv_h,
+        joint_soft: Softness::new(p.joint_hertz, p.joint_damping_ratio, h),
+        max_push: p.max_push_velocity,
+        restitution_threshold: p.restitution_threshold,
+        simd,
+    };
     lap(&mut t, &mut ctx.timings.prepare);
 
-    for _ in 0..n {
-        integrate::integrate_velocities(&mut terms[..], &ctx.set.rotation, ctx.bodies, h);
-        lap(&mut t, &mut ctx.timings.forces);
-
-        if p.warm_starting {
-            joints::warm_start(rows, ctx.bodies);
-            if simd {
-                let b = &mut *ctx.bodies;
-                let (w, s) = (contact_simd::warm_start, contact::warm_start);
-                contact_simd::solve(wide, cons, b, par, min, w, s);
-            } else {
-                solve_coloured(cons, ranges, ctx.bodies, par, min, contact::warm_start);
+    soft_stages::run(
+        plan, threads, consts, ctx.set, ctx.bodies, terms, scratch, rows, ctx.joints,
+    );
+    for (kind, d) in plan.durations() {
+        let slot = match kind {
+            SoftStage::IntegrateVelocities => &mut ctx.timings.forces,
+            SoftStage::IntegratePositions => &mut ctx.timings.integrate,
+            SoftStage::Joints(pass) | SoftStage::Colour(pass, _) | SoftStage::Overflow(pass) => {
+                match pass {
+                    Pass::WarmStart => &mut ctx.timings.warm_start,
+                    Pass::Solve => &mut ctx.timings.solve,
+                    Pass::Relax => &mut ctx.timings.relax,
+                    Pass::Restitution => &mut ctx.timings.restitution,
+                }
             }
-        }
-        lap(&mut t, &mut ctx.timings.warm_start);
-
-        joints::solve(rows, ctx.bodies, joint_soft, inv_h, true);
-        let solve = (inv_h, max_push, true);
-        solve_contacts(simd, wide, cons, ranges, ctx.bodies, (par, min), solve);
-        lap(&mut t, &mut ctx.timings.solve);
-
-        // The speed clamp of the solve and the position update, fused in one pass.
-        integrate::clamp_and_integrate_positions(terms, ctx.set, ctx.bodies, h);
-        lap(&mut t, &mut ctx.timings.integrate);
-
-        // Joint rows follow the new poses (they stay valid until the next position update).
-        joints::refresh(rows, ctx.joints, ctx.set, ctx.bodies);
-        joints::solve(rows, ctx.bodies, joint_soft, inv_h, false);
-        let relax = (inv_h, max_push, false);
-        solve_contacts(simd, wide, cons, ranges, ctx.bodies, (par, min), relax);
-        lap(&mut t, &mut ctx.timings.relax);
+        };
+        *slot += d;
     }
+    t = Instant::now();
 
-    let threshold = p.restitution_threshold;
     if simd {
-        contact_simd::solve_active(
-            wide,
-            cons,
-            ctx.bodies,
-            (par, min),
-            contact_simd::has_restitution,
-            |c, a, b| contact_simd::apply_restitution(c, a, b, threshold),
-            |c, a, b| contact::apply_restitution(c, a, b, threshold),
-        );
-        contact_simd::store(wide, ctx.manifolds, n as Real);
-    } else {
-        solve_coloured(cons, ranges, ctx.bodies, par, min, |c, a, b| {
-            contact::apply_restitution(c, a, b, threshold)
-        });
+        contact_simd::store(&scratch.wide, ctx.manifolds, n as Real);
     }
-    lap(&mut t, &mut ctx.timings.restitution);
-
-    contact::store(cons, ctx.manifolds, n as Real);
+    contact::store(&scratch.cons, ctx.manifolds, n as Real);
     joints::store(rows, ctx.joints, n as Real);
     lap(&mut t, &mut ctx.timings.store);
-}
-
-/// One soft contact pass (`(inv_h, max_push, use_bias)`) over every colour: four-wide with
-/// SIMD when `simd` (the overflow colour scalar), else scalar; `(parallel, min_batch)` as
-/// in [`solve_coloured`].
-fn solve_contacts(
-    simd: bool,
-    wide: &mut WideScratch,
-    cons: &mut [ContactConstraint],
-    ranges: &[Range<usize>],
-    bodies: &mut [SolverBody],
-    (par, min): (bool, usize),
-    (inv_h, max_push, use_bias): (Real, Real, bool),
-) {
-    if simd {
-        contact_simd::solve(
-            wide,
-            cons,
-            bodies,
-            par,
-            min,
-            |c, a, b| contact_simd::solve_soft(c, a, b, inv_h, max_push, use_bias),
-            |c, a, b| contact::solve_soft(c, a, b, inv_h, max_push, use_bias),
-        );
-    } else {
-        solve_coloured(cons, ranges, bodies, par, min, |c, a, b| {
-            contact::solve_soft(c, a, b, inv_h, max_push, use_bias)
-        });
-    }
 }

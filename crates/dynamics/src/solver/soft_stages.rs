@@ -1,0 +1,346 @@
+//! The soft step's stage list and the executor of its blocks (Box2D v3's `b2SolverStage_*`
+//! values and `b2ExecuteBlock`), run by module `stages`.
+//!
+//! Per substep: integrate velocities (blocks of bodies); warm start the joints (one block),
+//! then every colour (blocks of constraints), then the overflow colour (one block); solve
+//! likewise; integrate positions (blocks of bodies); refresh and relax the joints (one
+//! block), relax every colour and the overflow colour. After the last substep: restitution
+//! over the colours and the overflow colour. This is exactly the order of the sequential
+//! solve, and inside a stage the blocks touch disjoint bodies (a colour's constraints share
+//! no dynamic body; a body stage handles each body once), so the result is the same bits
+//! whatever the thread count. Block sizes are constants and never depend on the thread count.
+
+use super::coloring;
+use super::contact::{self, ContactConstraint, ContactScratch};
+use super::contact_simd::{self, WideBody, WideConstraint};
+use super::joints::{self, JointScratch};
+use super::stages::{block_count, block_range, StageList};
+use super::{Softness, SolverBody};
+use crate::body_set::BodySet;
+use crate::integrate::{self, BodyTerms};
+use crate::joint::JointSet;
+use carom_collision::math::{Quat, Real, Vec3};
+use std::ops::Range;
+
+/// Bodies per block of the body stages.
+pub(crate) const BODY_BLOCK: usize = 128;
+/// Wide (four-lane) constraints per block of a colour stage.
+pub(crate) const WIDE_BLOCK: usize = 16;
+/// Scalar constraints per block of a colour stage (SIMD off).
+pub(crate) const SCALAR_BLOCK: usize = 64;
+
+/// A contact or joint pass.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Pass {
+    /// Apply the accumulated impulses.
+    WarmStart,
+    /// Solve with soft position feedback.
+    Solve,
+    /// Solve without bias (the joints' rows refreshed to the new poses first).
+    Relax,
+    /// Restitution (contacts only, after the last substep).
+    Restitution,
+}
+
+/// One stage of the soft step.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum SoftStage {
+    /// Gravity, forces, damping and the gyroscopic term, in blocks of bodies.
+    IntegrateVelocities,
+    /// Every joint, in slot order (one block).
+    Joints(Pass),
+    /// Colour `k` (an index into the colour ranges), in blocks of constraints.
+    Colour(Pass, u8),
+    /// The overflow colour, whose constraints may share bodies (one block).
+    Overflow(Pass),
+    /// Speed clamp and position update, in blocks of bodies.
+    IntegratePositions,
+}
+
+/// What the stage list of a step depends on.
+pub(crate) struct Shape<'a> {
+    pub substeps: u32,
+    pub warm_starting: bool,
+    /// Whether there are joint rows.
+    pub joints: bool,
+    /// Colour ranges (wide constraints with SIMD, scalar ones without), overflow excluded.
+    pub colours: &'a [Range<usize>],
+    /// Scalar constraints per item of `colours` (4 with SIMD, else 1).
+    pub lanes: usize,
+    /// Constraints of the overflow colour.
+    pub overflow: usize,
+    /// Moving bodies (integration terms).
+    pub bodies: usize,
+    /// Colours of fewer scalar constraints are one block ([`super::SolverParams`]'s
+    /// `parallel_min_batch`).
+    pub min_batch: usize,
+}
+
+impl Shape<'_> {
+    /// Blocks of colour `r`.
+    fn colour_blocks(&self, r: &Range<usize>) -> usize {
+        if r.is_empty() {
+            0
+        } else if r.len() * self.lanes < self.min_batch {
+            1
+        } else {
+            block_count(r.len(), self.item_block())
+        }
+    }
+
+    fn item_block(&self) -> usize {
+        if self.lanes > 1 {
+            WIDE_BLOCK
+        } else {
+            SCALAR_BLOCK
+        }
+    }
+
+    /// The contact and joint stages of one pass.
+    fn pass(&self, list: &mut StageList<SoftStage>, pass: Pass) {
+        if pass != Pass::Restitution {
+            list.push(SoftStage::Joints(pass), usize::from(self.joints));
+        }
+        for (k, r) in self.colours.iter().enumerate() {
+            let k = u8::try_from(k).unwrap_or(u8::MAX);
+            list.push(SoftStage::Colour(pass, k), self.colour_blocks(r));
+        }
+        list.push(SoftStage::Overflow(pass), usize::from(self.overflow > 0));
+    }
+}
+
+/// Fills `list` with the stages of one soft step.
+pub(crate) fn plan(list: &mut StageList<SoftStage>, s: &Shape) {
+    list.clear();
+    let body_blocks = block_count(s.bodies, BODY_BLOCK);
+    for _ in 0..s.substeps {
+        list.push(SoftStage::IntegrateVelocities, body_blocks);
+        if s.warm_starting {
+            s.pass(list, Pass::WarmStart);
+        }
+        s.pass(list, Pass::Solve);
+        list.push(SoftStage::IntegratePositions, body_blocks);
+        s.pass(list, Pass::Relax);
+    }
+    s.pass(list, Pass::Restitution);
+}
+
+/// Per-step constants of the passes.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Consts {
+    pub h: Real,
+    pub inv_h: Real,
+    pub joint_soft: Softness,
+    pub max_push: Real,
+    pub restitution_threshold: Real,
+    pub simd: bool,
+}
+
+/// Raw views of everything the blocks write, shared by the threads of the region.
+struct Shared<'a> {
+    c: Consts,
+    bodies: *mut SolverBody,
+    n_bodies: usize,
+    terms: *mut BodyTerms,
+    n_terms: usize,
+    set: *mut BodySet,
+    position: *mut Vec3,
+    rotation: *mut Quat,
+    n_poses: usize,
+    wide: *mut WideConstraint,
+    n_wide: usize,
+    colours: &'a [Range<usize>],
+    cons: *mut ContactConstraint,
+    n_cons: usize,
+    overflow: Range<usize>,
+    rows: *mut JointScratch,
+    joints: &'a JointSet,
+}
+
+// SAFETY: the stage machinery runs blocks of one stage at a time, and the blocks of a stage
+// write disjoint data (see the module docs and `Shared::exec`); everything else is read.
+unsafe impl Sync for Shared<'_> {}
+
+/// Runs the stages of `list` (from [`plan`]) on up to `threads` threads.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn run(
+    list: &mut StageList<SoftStage>,
+    threads: usize,
+    c: Consts,
+    set: &mut BodySet,
+    bodies: &mut [SolverBody],
+    terms: &mut [BodyTerms],
+    scratch: &mut ContactScratch,
+    rows: &mut JointScratch,
+    joints: &JointSet,
+) {
+    let n_poses = set.position.len().min(set.rotation.len());
+    let (colours, overflow) = if c.simd {
+        (&scratch.wide.ranges[..], scratch.wide.overflow.clone())
+    } else {
+        let r = &scratch.colouring.ranges[..];
+        let (last, colours) = r.split_last().map_or((0..0, r), |(l, c)| (l.clone(), c));
+        (colours, last)
+    };
+    let shared = Shared {
+        c,
+        n_bodies: bodies.len(),
+        bodies: bodies.as_mut_ptr(),
+        n_terms: terms.len(),
+        terms: terms.as_mut_ptr(),
+        position: set.position.as_mut_ptr(),
+        rotation: set.rotation.as_mut_ptr(),
+        n_poses,
+        set,
+        n_wide: scratch.wide.cons.len(),
+        wide: scratch.wide.cons.as_mut_ptr(),
+        colours,
+        n_cons: scratch.cons.len(),
+        cons: scratch.cons.as_mut_ptr(),
+        overflow,
+        rows,
+        joints,
+    };
+    // SAFETY: see `Shared::exec`.
+    list.run(threads, |kind, block, blocks| unsafe {
+        shared.exec(kind, block, blocks)
+    });
+}
+
+impl Shared<'_> {
+    /// Runs block `block` of the `blocks` blocks of a stage of kind `kind` (each block an
+    /// even share of the stage's items, [`block_range`]).
+    ///
+    /// # Safety
+    /// Only blocks of one stage run at the same time. Body blocks touch the bodies (and their
+    /// terms and poses) of their own range of terms, and every body appears in one term;
+    /// colour blocks touch their own constraints and their dynamic bodies, disjoint within a
+    /// colour; joint and overflow stages are a single block.
+    unsafe fn exec(&self, kind: SoftStage, block: usize, blocks: usize) {
+        let c = &self.c;
+        match kind {
+            SoftStage::IntegrateVelocities => {
+                for i in block_range(self.n_terms, blocks, block) {
+                    let t = &mut *self.terms.add(i);
+                    let s = t.slot();
+                    assert!(s < self.n_bodies && s < self.n_poses);
+                    let q = *self.rotation.add(s);
+                    integrate::integrate_velocity(t, q, &mut *self.bodies.add(s), c.h);
+                }
+            }
+            SoftStage::IntegratePositions => {
+                for i in block_range(self.n_terms, blocks, block) {
+                    let t = &*self.terms.add(i);
+                    let s = t.slot();
+                    assert!(s < self.n_bodies && s < self.n_poses);
+                    let (p, q) = (&mut *self.position.add(s), &mut *self.rotation.add(s));
+                    let b = &mut *self.bodies.add(s);
+                    integrate::clamp_and_integrate_position(t, p, q, b, c.h);
+                }
+            }
+            SoftStage::Joints(pass) => {
+                let rows = &mut *self.rows;
+                let bodies = std::slice::from_raw_parts_mut(self.bodies, self.n_bodies);
+                let (soft, inv_h) = (c.joint_soft, c.inv_h);
+                match pass {
+                    Pass::WarmStart => joints::warm_start(rows, bodies),
+                    Pass::Solve => joints::solve(rows, bodies, soft, inv_h, true),
+                    Pass::Relax => {
+                        // Joint rows follow the new poses (valid until the next position
+                        // update).
+                        joints::refresh(rows, self.joints, &*self.set, bodies);
+                        joints::solve(rows, bodies, soft, inv_h, false);
+                    }
+                    Pass::Restitution => {}
+                }
+            }
+            SoftStage::Colour(pass, k) => {
+                let r = &self.colours[k as usize];
+                let b = block_range(r.len(), blocks, block);
+                let range = r.start + b.start..r.start + b.end;
+                let items = if c.simd { self.n_wide } else { self.n_cons };
+                assert!(range.end <= items);
+                if c.simd {
+                    self.wide_pass(pass, range);
+                } else {
+                    self.scalar_pass(pass, range);
+                }
+            }
+            SoftStage::Overflow(pass) => {
+                let range = self.overflow.clone();
+                assert!(range.end <= self.n_cons);
+                self.scalar_pass(pass, range);
+            }
+        }
+    }
+
+    /// A pass over the wide constraints `range`.
+    unsafe fn wide_pass(&self, pass: Pass, range: Range<usize>) {
+        let (c, b, n) = (&self.c, self.bodies, self.n_bodies);
+        let (inv_h, max_push, threshold) = (c.inv_h, c.max_push, c.restitution_threshold);
+        let all = |_: &WideConstraint| true;
+        let cons = self.wide;
+        match pass {
+            Pass::WarmStart => contact_simd::solve_range(cons, range, b, n, &wide_warm_start, &all),
+            Pass::Solve | Pass::Relax => {
+                let bias = pass == Pass::Solve;
+                let f =
+                    |w: &mut _, x: &mut _, y: &mut _| wide_solve(w, x, y, inv_h, max_push, bias);
+                contact_simd::solve_range(cons, range, b, n, &f, &all);
+            }
+            Pass::Restitution => {
+                let f = |w: &mut _, x: &mut _, y: &mut _| wide_restitution(w, x, y, threshold);
+                let active = contact_simd::has_restitution;
+                contact_simd::solve_range(cons, range, b, n, &f, &active);
+            }
+        }
+    }
+
+    /// A pass over the scalar constraints `range`.
+    unsafe fn scalar_pass(&self, pass: Pass, range: Range<usize>) {
+        let (c, b, n) = (&self.c, self.bodies, self.n_bodies);
+        let (inv_h, max_push, threshold) = (c.inv_h, c.max_push, c.restitution_threshold);
+        let cons = self.cons;
+        match pass {
+            Pass::WarmStart => coloring::solve_range(cons, range, b, n, &contact::warm_start),
+            Pass::Solve | Pass::Relax => {
+                let bias = pass == Pass::Solve;
+                let f = |k: &mut ContactConstraint, x: &mut _, y: &mut _| {
+                    contact::solve_soft(k, x, y, inv_h, max_push, bias)
+                };
+                coloring::solve_range(cons, range, b, n, &f);
+            }
+            Pass::Restitution => {
+                let f = |k: &mut ContactConstraint, x: &mut _, y: &mut _| {
+                    contact::apply_restitution(k, x, y, threshold)
+                };
+                coloring::solve_range(cons, range, b, n, &f);
+            }
+        }
+    }
+}
+
+// The wide kernels behind calls that are not inlined: inlined into `solve_range`, they left
+// the gather's array maps out of line (+4.6 % instructions on "1000 stack", callgrind).
+
+#[inline(never)]
+fn wide_warm_start(c: &mut WideConstraint, a: &mut WideBody, b: &mut WideBody) {
+    contact_simd::warm_start(c, a, b);
+}
+
+#[inline(never)]
+fn wide_solve(
+    c: &mut WideConstraint,
+    a: &mut WideBody,
+    b: &mut WideBody,
+    inv_h: Real,
+    max_push: Real,
+    bias: bool,
+) {
+    contact_simd::solve_soft(c, a, b, inv_h, max_push, bias);
+}
+
+#[inline(never)]
+fn wide_restitution(c: &mut WideConstraint, a: &mut WideBody, b: &mut WideBody, threshold: Real) {
+    contact_simd::apply_restitution(c, a, b, threshold);
+}
