@@ -235,8 +235,13 @@ impl DynamicsWorld {
             }
         }
         let mut report = StepReport::default();
-        island::build(&self.bodies, contacts, &self.joints, &mut self.islands);
-        report.woken = island::wake_islands(&mut self.bodies, &mut self.islands, contacts);
+        let islands = island::needed(&self.bodies, &self.params.sleep, dt);
+        if islands {
+            island::build(&self.bodies, contacts, &self.joints, &mut self.islands);
+            report.woken = island::wake_islands(&mut self.bodies, &mut self.islands, contacts);
+        } else {
+            report.woken = island::user_woken(&mut self.bodies);
+        }
         report.timings.islands = start.elapsed();
 
         integrate::load(&self.bodies, &mut self.solver_bodies);
@@ -268,8 +273,13 @@ impl DynamicsWorld {
                 report.broken_joints.push(jh);
             }
         }
-        report.slept =
-            island::update_sleep(&mut self.bodies, &mut self.islands, dt, &self.params.sleep);
+        report.slept = island::update_sleep(
+            &mut self.bodies,
+            &mut self.islands,
+            dt,
+            &self.params.sleep,
+            islands,
+        );
         report.timings.store += t.elapsed();
         report.timings.total = start.elapsed();
         Ok(report)
