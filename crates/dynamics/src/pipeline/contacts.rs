@@ -1,9 +1,11 @@
 //! The adapter between the narrowphase's persistent manifolds and the solver's contacts.
 //!
-//! `gather` turns every non-empty, non-sensor narrowphase manifold whose bodies should
-//! collide into a [`ContactManifold`] (normal A→B, see the module docs of
-//! [`crate::pipeline`]) in a reused buffer, carrying the accumulated impulses in;
-//! `write_back` stores the solver's impulses into the same narrowphase points afterwards.
+//! `gather` turns every non-empty, non-sensor narrowphase manifold with a dynamic body into
+//! a [`ContactManifold`] (normal A→B, see the module docs of [`crate::pipeline`]) in a
+//! reused buffer, carrying the accumulated impulses in; `write_back` stores the solver's
+//! impulses into the same narrowphase points afterwards. Pairs whose joint disables
+//! collisions never get points: the world excludes them from contact generation
+//! ([`World::create_joint`]).
 //! Both walk the narrowphase's manifolds in pair order, so entry `k` of the buffer maps back
 //! by its rank `sources[k].0` without any lookup table; `sources[k].1` keeps the sign that
 //! maps the second tangent impulse, so the frame is computed once per manifold.
@@ -31,21 +33,8 @@ fn frame(m: &NarrowManifold) -> (Vec3, Vec3, Real) {
 }
 
 impl World {
-    /// Rebuilds the sorted list of body pairs whose joint disables collisions.
-    fn collect_disabled(&mut self) {
-        self.disabled.clear();
-        for (_, j) in self.dynamics.joints().iter() {
-            if j.desc.disable_collisions && !j.broken {
-                let (a, b) = (j.desc.body_a.index, j.desc.body_b.index);
-                self.disabled.push((a.min(b), a.max(b)));
-            }
-        }
-        self.disabled.sort_unstable();
-    }
-
     /// Fills `self.contacts` from the narrowphase (see the module docs).
     pub(super) fn gather(&mut self) {
-        self.collect_disabled();
         self.contacts.clear();
         self.sources.clear();
         let set = self.dynamics.bodies();
@@ -65,10 +54,6 @@ impl World {
             let (info_a, info_b) = (&set.info[ia], &set.info[ib]);
             let dynamic = |t: BodyType| t == BodyType::Dynamic;
             if !(dynamic(info_a.body_type) || dynamic(info_b.body_type)) {
-                continue;
-            }
-            let key = (ba.index.min(bb.index), ba.index.max(bb.index));
-            if !self.disabled.is_empty() && self.disabled.binary_search(&key).is_ok() {
                 continue;
             }
             let (n_b, t1, sign) = frame(&pc.manifold);
