@@ -109,9 +109,8 @@ pub struct World {
     resting: Vec<bool>,
     /// Solver contacts of the current step (reused buffer).
     contacts: Vec<ContactManifold>,
-    /// For each entry of `contacts`, its rank among the non-empty narrowphase manifolds and
-    /// the sign that maps its second tangent impulse (see `contacts.rs`).
-    sources: Vec<(u32, Real)>,
+    /// For each entry of `contacts`, the index of its narrowphase pair (see `contacts.rs`).
+    sources: Vec<u32>,
     /// Time not yet simulated by [`World::step_simulation`].
     accumulator: Real,
     report: PipelineReport,

@@ -60,10 +60,12 @@ impl World {
         let ct = self.collision.timings();
 
         let t = Instant::now();
-        self.gather();
+        let checked = self.gather();
         let gather = t.elapsed();
 
-        let dyn_report = self.dynamics.step(dt, &mut self.contacts)?;
+        let dyn_report = self
+            .dynamics
+            .step_gathered(dt, &mut self.contacts, checked)?;
 
         let t = Instant::now();
         self.write_back();
