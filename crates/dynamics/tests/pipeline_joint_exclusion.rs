@@ -87,7 +87,11 @@ fn a_jointed_pair_gets_no_manifold_until_its_joint_is_removed() {
     assert!(!p.excluded && p.manifold.len() == 4 && p.touching);
     assert_eq!(events(&w, a, b), [ContactEventKind::Begin]);
     w.step(DT).unwrap();
-    assert!(pos(&w, a).x < -1e-4, "the contact pushes A away: {}", pos(&w, a));
+    assert!(
+        pos(&w, a).x < -1e-4,
+        "the contact pushes A away: {}",
+        pos(&w, a)
+    );
 
     // A new disabling joint while touching: the pair ends at the next step.
     let j = w.create_joint(&joint(a, b, true)).unwrap();
@@ -117,7 +121,10 @@ fn a_broken_joint_lets_its_bodies_collide() {
     let j = w.create_joint(&d).unwrap();
     let r = w.step(DT).unwrap();
     assert_eq!(r.dynamics.broken_joints, [j]);
-    assert_eq!(r.manifolds, 0, "excluded during the step that broke the joint");
+    assert_eq!(
+        r.manifolds, 0,
+        "excluded during the step that broke the joint"
+    );
     // Lifted at the end of that step, generated at the next one.
     let p = pair(&w, a, b);
     assert!(!p.excluded && p.manifold.is_empty());
@@ -141,7 +148,10 @@ fn exclusions_survive_snapshots_and_go_with_removed_bodies() {
     let (oa, ob) = objects(&restored, a, b);
     assert!(restored.collision().narrowphase().is_excluded(oa, ob));
     for _ in 0..5 {
-        let (r1, r2) = (w.step(DT).unwrap().clone(), restored.step(DT).unwrap().clone());
+        let (r1, r2) = (
+            w.step(DT).unwrap().clone(),
+            restored.step(DT).unwrap().clone(),
+        );
         assert_eq!((r1.pairs, r1.manifolds), (r2.pairs, r2.manifolds));
         // Only the A–C pair touches.
         assert_eq!(r1.manifolds, 1);
@@ -166,7 +176,10 @@ fn ragdolls_hand_the_same_contacts_with_fewer_pairs_generated() {
         let np = w.collision().narrowphase();
         let mut excluded = 0;
         for p in np.pairs() {
-            let (ba, bb) = (w.body_of_object(p.a).unwrap(), w.body_of_object(p.b).unwrap());
+            let (ba, bb) = (
+                w.body_of_object(p.a).unwrap(),
+                w.body_of_object(p.b).unwrap(),
+            );
             let disabled = w.joints().collision_disabled(ba, bb);
             assert_eq!(p.excluded, disabled, "{ba:?} {bb:?}");
             if p.excluded {
