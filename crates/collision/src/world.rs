@@ -280,6 +280,21 @@ impl CollisionWorld {
         Ok(())
     }
 
+    /// Excludes the pair of live objects `a`, `b` from contact generation, or lets it back
+    /// in ([`NarrowPhase::set_excluded`]): the broadphase still pairs them, the narrowphase
+    /// keeps their manifold empty. Lifted when either object is removed.
+    pub fn set_pair_excluded(
+        &mut self,
+        a: ObjectHandle,
+        b: ObjectHandle,
+        excluded: bool,
+    ) -> Result<()> {
+        self.slot(a)?;
+        self.slot(b)?;
+        self.narrowphase.set_excluded(a, b, excluded);
+        Ok(())
+    }
+
     /// Changes an object's filter.
     pub fn set_filter(&mut self, h: ObjectHandle, filter: Filter) -> Result<()> {
         let i = self.slot(h)?;
@@ -300,10 +315,12 @@ impl CollisionWorld {
         Ok(())
     }
 
-    /// Removes an object; its pairs are reported as removed by the next update.
+    /// Removes an object; its pairs are reported as removed by the next update, and the
+    /// exclusions naming it are lifted.
     pub fn remove(&mut self, h: ObjectHandle) -> Result<CollisionObject> {
         let i = self.slot(h)?;
         self.broadphase.remove_proxy(h.proxy())?;
+        self.narrowphase.clear_exclusions_of(h);
         Ok(self.objects[i].take().expect("slot checked"))
     }
 

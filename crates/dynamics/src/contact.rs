@@ -67,8 +67,8 @@ pub struct ContactManifold {
     pub friction: Real,
     /// Combined restitution (e.g. [`crate::mix_restitution`]).
     pub restitution: Real,
-    points: [ContactPoint; MAX_MANIFOLD_POINTS],
-    len: usize,
+    pub(crate) points: [ContactPoint; MAX_MANIFOLD_POINTS],
+    pub(crate) len: usize,
 }
 
 impl ContactManifold {

@@ -84,7 +84,33 @@ pub(crate) struct IslandScratch {
     min_time: Vec<Real>,
 }
 
+/// True when this step needs the islands: a dynamic body sleeps (its island may have to
+/// wake), or sleeping is enabled and an awake dynamic body may reach `time_to_sleep` during
+/// the step (its rest timer, which grows by at most `dt` per step, is within `dt` of it; the
+/// test is the very sum [`update_sleep`] compares). Otherwise building them is wasted: no
+/// island can wake or fall asleep, so [`wake_islands`] would wake nothing and
+/// [`update_sleep`] put nothing to sleep (Box2D v3 likewise keeps its islands only for
+/// sleeping). With sleeping off, as in the benchmarks, this skips the union-find over every
+/// contact and joint.
+#[inline(never)] // its own entry in profiles
+pub(crate) fn needed(set: &BodySet, params: &SleepParams, dt: Real) -> bool {
+    #[cfg(test)]
+    if tests::FORCE.with(|f| f.get()) {
+        return true;
+    }
+    (0..set.capacity()).any(|i| {
+        let info = &set.info[i];
+        set.is_alive(i)
+            && info.body_type == BodyType::Dynamic
+            && (info.sleeping
+                || (params.enabled
+                    && info.can_sleep
+                    && info.sleep_time + dt >= params.time_to_sleep))
+    })
+}
+
 /// Computes the island root of every body slot into `scratch.roots`.
+#[inline(never)] // its own entry in profiles
 pub(crate) fn build(
     set: &BodySet,
     manifolds: &[ContactManifold],
@@ -119,6 +145,7 @@ pub(crate) fn build(
 /// Wakes every sleeping body whose island holds an awake body or touches a moving kinematic
 /// body. Returns the bodies woken since the last step (by this or by user calls), in slot
 /// order.
+#[inline(never)] // its own entry in profiles
 pub(crate) fn wake_islands(
     set: &mut BodySet,
     scratch: &mut IslandScratch,
@@ -128,12 +155,18 @@ pub(crate) fn wake_islands(
     let awake = &mut scratch.awake;
     awake.clear();
     awake.resize(roots.len(), false);
+    let mut moving_kinematic = false;
     for i in 0..roots.len() {
         if set.is_awake_dynamic(i) {
             awake[roots[i]] = true;
         }
+        moving_kinematic |= set.is_alive(i)
+            && set.info[i].body_type == BodyType::Kinematic
+            && (set.linear_velocity[i] != Vec3::ZERO || set.angular_velocity[i] != Vec3::ZERO);
     }
-    for m in manifolds.iter().filter(|m| !m.points().is_empty()) {
+    // The contacts matter only when a kinematic body moves.
+    let touching = if moving_kinematic { manifolds } else { &[] };
+    for m in touching.iter().filter(|m| !m.points().is_empty()) {
         let (a, b) = (m.body_a.index as usize, m.body_b.index as usize);
         for (k, d) in [(a, b), (b, a)] {
             let kinematic = set.is_alive(k) && set.info[k].body_type == BodyType::Kinematic;
@@ -152,6 +185,18 @@ pub(crate) fn wake_islands(
         }
     }
     set.woken_by_user.clear();
+    woken_handles(set, slots)
+}
+
+/// The bodies woken by user calls since the last step, in slot order (what
+/// [`wake_islands`] returns when no island sleeps).
+pub(crate) fn user_woken(set: &mut BodySet) -> Vec<BodyHandle> {
+    let slots = std::mem::take(&mut set.woken_by_user);
+    woken_handles(set, slots)
+}
+
+/// The live bodies of `slots`, sorted and deduplicated, as handles.
+fn woken_handles(set: &BodySet, mut slots: Vec<usize>) -> Vec<BodyHandle> {
     slots.sort_unstable();
     slots.dedup();
     slots
@@ -161,35 +206,53 @@ pub(crate) fn wake_islands(
         .collect()
 }
 
+/// Advances the rest timer of body slot `i` (awake, dynamic) and returns it.
+fn advance_timer(set: &mut BodySet, i: usize, dt: Real, lin_sq: Real, ang_sq: Real) -> Real {
+    let resting = set.info[i].can_sleep
+        && set.linear_velocity[i].length_squared() <= lin_sq
+        && set.angular_velocity[i].length_squared() <= ang_sq;
+    let info = &mut set.info[i];
+    info.sleep_time = if resting { info.sleep_time + dt } else { 0.0 };
+    info.sleep_time
+}
+
 /// Advances the rest timers and puts resting islands to sleep. Returns the bodies that fell
-/// asleep, in slot order.
+/// asleep, in slot order. Without `islands` (not built this step, see [`needed`]) only the
+/// timers advance: no island can reach `time_to_sleep` then.
+#[inline(never)] // its own entry in profiles
 pub(crate) fn update_sleep(
     set: &mut BodySet,
     scratch: &mut IslandScratch,
     dt: Real,
     params: &SleepParams,
+    islands: bool,
 ) -> Vec<BodyHandle> {
     if !params.enabled {
+        return Vec::new();
+    }
+    let (lin_sq, ang_sq) = (
+        params.linear_threshold * params.linear_threshold,
+        params.angular_threshold * params.angular_threshold,
+    );
+    if !islands {
+        for i in 0..set.capacity() {
+            if set.is_awake_dynamic(i) {
+                let t = advance_timer(set, i, dt, lin_sq, ang_sq);
+                debug_assert!(t < params.time_to_sleep, "slot {i} rested {t} s");
+            }
+        }
         return Vec::new();
     }
     let roots = &scratch.roots;
     let min_time = &mut scratch.min_time;
     min_time.clear();
     min_time.resize(roots.len(), Real::INFINITY);
-    let (lin_sq, ang_sq) = (
-        params.linear_threshold * params.linear_threshold,
-        params.angular_threshold * params.angular_threshold,
-    );
     for (i, &r) in roots.iter().enumerate() {
         if !set.is_awake_dynamic(i) {
             continue;
         }
-        let resting = set.info[i].can_sleep
-            && set.linear_velocity[i].length_squared() <= lin_sq
-            && set.angular_velocity[i].length_squared() <= ang_sq;
-        let info = &mut set.info[i];
-        info.sleep_time = if resting { info.sleep_time + dt } else { 0.0 };
-        min_time[r] = min_time[r].min(info.sleep_time);
+        let t = advance_timer(set, i, dt, lin_sq, ang_sq);
+        min_time[r] = min_time[r].min(t);
     }
     let mut slept = Vec::new();
     for i in 0..roots.len() {
@@ -201,4 +264,101 @@ pub(crate) fn update_sleep(
         }
     }
     slept
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::collision::math::{Isometry, Quat, Real, Vec3};
+    use crate::collision::shape::{Cuboid, Shape};
+    use crate::{BodyDesc, BodyHandle, BodyType, PipelineParams, World};
+    use std::cell::Cell;
+    use std::sync::Arc;
+
+    thread_local! {
+        /// Makes [`super::needed`] answer true: the oracle builds the islands every step.
+        pub(super) static FORCE: Cell<bool> = const { Cell::new(false) };
+    }
+
+    fn cuboid(h: Vec3) -> Arc<Shape> {
+        Arc::new(Cuboid::new(h).unwrap().into())
+    }
+
+    /// Per step: the state hash and the bodies woken and put to sleep.
+    type Trace = Vec<(u64, Vec<BodyHandle>, Vec<BodyHandle>)>;
+
+    /// A stack of three boxes beside a kinematic pusher that starts moving at step 150; a
+    /// box dropped on the stack at step 200; a user wake-up at step 300; a second stack
+    /// that never sleeps (`can_sleep` false on its bottom box).
+    fn run(force: bool, time_to_sleep: Real) -> Trace {
+        FORCE.with(|f| f.set(force));
+        let mut p = PipelineParams::default();
+        p.dynamics.gravity = Vec3::new(0.0, -10.0, 0.0);
+        p.dynamics.sleep.enabled = true;
+        p.dynamics.sleep.time_to_sleep = time_to_sleep;
+        p.dynamics.parallel = false;
+        let mut w = World::new(p).unwrap();
+        let ground = BodyDesc::fixed(
+            cuboid(Vec3::new(50.0, 1.0, 50.0)),
+            Isometry::from_translation(Vec3::new(0.0, -1.0, 0.0)),
+        );
+        w.add_body(&ground).unwrap();
+        let at = |x: Real, y: Real| Isometry::new(Vec3::new(x, y, 0.0), Quat::IDENTITY);
+        let mut stack = Vec::new();
+        for (x, no_sleep) in [(0.0, false), (5.0, true)] {
+            for k in 0..3 {
+                let mut d =
+                    BodyDesc::dynamic(cuboid(Vec3::splat(0.5)), at(x, 0.5 + k as Real), 1.0);
+                d.can_sleep = !(no_sleep && k == 0);
+                stack.push(w.add_body(&d).unwrap());
+            }
+        }
+        let mut pusher = BodyDesc::fixed(cuboid(Vec3::splat(0.5)), at(-3.0, 0.5));
+        pusher.body_type = BodyType::Kinematic;
+        let pusher = w.add_body(&pusher).unwrap();
+        let mut trace = Trace::new();
+        for step in 0..400 {
+            match step {
+                150 => w
+                    .bodies_mut()
+                    .set_linear_velocity(pusher, Vec3::new(1.0, 0.0, 0.0))
+                    .unwrap(),
+                170 => w
+                    .bodies_mut()
+                    .set_linear_velocity(pusher, Vec3::ZERO)
+                    .unwrap(),
+                200 => {
+                    let d = BodyDesc::dynamic(cuboid(Vec3::splat(0.3)), at(0.1, 5.0), 1.0);
+                    w.add_body(&d).unwrap();
+                }
+                300 => w.bodies_mut().wake(stack[1]).unwrap(),
+                _ => {}
+            }
+            let r = w.step(1.0 / 60.0).unwrap();
+            let (woken, slept) = (r.dynamics.woken.clone(), r.dynamics.slept.clone());
+            trace.push((w.state_hash(), woken, slept));
+        }
+        FORCE.with(|f| f.set(false));
+        trace
+    }
+
+    /// Skipping the islands when no body sleeps or can fall asleep this step
+    /// ([`super::needed`]) changes nothing: the same states, wake-ups and sleeps every step as
+    /// building them every step.
+    #[test]
+    fn skipping_the_islands_matches_building_them_every_step() {
+        for time_to_sleep in [0.5, 1.0 / 60.0, 0.0] {
+            let (fast, oracle) = (run(false, time_to_sleep), run(true, time_to_sleep));
+            let (woken, slept) = oracle
+                .iter()
+                .fold((0, 0), |(w, s), t| (w + t.1.len(), s + t.2.len()));
+            // The run exercises both sleeping and waking.
+            assert!(
+                woken > 0 && slept > 0,
+                "{time_to_sleep}: woken {woken} slept {slept}"
+            );
+            for (k, (a, b)) in fast.iter().zip(&oracle).enumerate() {
+                assert_eq!(a, b, "time_to_sleep {time_to_sleep}, step {k}");
+            }
+        }
+    }
 }

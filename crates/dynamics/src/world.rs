@@ -218,6 +218,18 @@ impl DynamicsWorld {
     /// each manifold (warm start) and writes this step's back. All input is validated before
     /// anything changes.
     pub fn step(&mut self, dt: Real, contacts: &mut [ContactManifold]) -> Result<StepReport> {
+        self.step_gathered(dt, contacts, false)
+    }
+
+    /// [`DynamicsWorld::step`] for contacts that are known to pass its per-manifold checks
+    /// when `checked` (the pipeline's adapter tests the same conditions while it copies the
+    /// manifolds, see `pipeline/contacts.rs`); with `checked` false, exactly `step`.
+    pub(crate) fn step_gathered(
+        &mut self,
+        dt: Real,
+        contacts: &mut [ContactManifold],
+        checked: bool,
+    ) -> Result<StepReport> {
         let start = Instant::now();
         if !(dt.is_finite() && dt > 0.0) {
             return Err(CaromError::invalid("dt", dt, "must be finite and > 0"));
@@ -225,7 +237,9 @@ impl DynamicsWorld {
         for (k, m) in contacts.iter().enumerate() {
             // The full check (which names the bad value) only for a manifold that fails the
             // cheap one; both accept the same manifolds, the cheap one possibly fewer.
-            if !plausible(m, &self.bodies) {
+            if checked {
+                debug_assert!(plausible(m, &self.bodies), "contacts[{k}]: {m:?}");
+            } else if !plausible(m, &self.bodies) {
                 m.validate(k, &self.bodies)?;
             }
         }
@@ -235,8 +249,13 @@ impl DynamicsWorld {
             }
         }
         let mut report = StepReport::default();
-        island::build(&self.bodies, contacts, &self.joints, &mut self.islands);
-        report.woken = island::wake_islands(&mut self.bodies, &mut self.islands, contacts);
+        let islands = island::needed(&self.bodies, &self.params.sleep, dt);
+        if islands {
+            island::build(&self.bodies, contacts, &self.joints, &mut self.islands);
+            report.woken = island::wake_islands(&mut self.bodies, &mut self.islands, contacts);
+        } else {
+            report.woken = island::user_woken(&mut self.bodies);
+        }
         report.timings.islands = start.elapsed();
 
         integrate::load(&self.bodies, &mut self.solver_bodies);
@@ -268,8 +287,13 @@ impl DynamicsWorld {
                 report.broken_joints.push(jh);
             }
         }
-        report.slept =
-            island::update_sleep(&mut self.bodies, &mut self.islands, dt, &self.params.sleep);
+        report.slept = island::update_sleep(
+            &mut self.bodies,
+            &mut self.islands,
+            dt,
+            &self.params.sleep,
+            islands,
+        );
         report.timings.store += t.elapsed();
         report.timings.total = start.elapsed();
         Ok(report)

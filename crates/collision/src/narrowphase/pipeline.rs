@@ -24,6 +24,9 @@ pub struct PairContact<H> {
     pub touching: bool,
     /// True when one of the objects is a sensor.
     pub sensor: bool,
+    /// True when the pair is excluded from contact generation
+    /// ([`NarrowPhase::set_excluded`]): its manifold stays empty and it reports no events.
+    pub excluded: bool,
 }
 
 /// What the narrowphase needs to know about one object at a step.
@@ -96,6 +99,8 @@ pub struct ContactEvent<H> {
 pub struct NarrowPhase<H: Ord> {
     pairs: Vec<PairContact<H>>,
     sensors: BTreeSet<H>,
+    /// Excluded object pairs `(lower, higher)`, sorted ([`NarrowPhase::set_excluded`]).
+    excluded: Vec<(H, H)>,
     events: Vec<ContactEvent<H>>,
     /// Per pair, whether it touched before this step's update (reused buffer).
     was_touching: Vec<bool>,
@@ -111,6 +116,7 @@ impl<H: Ord> Default for NarrowPhase<H> {
         NarrowPhase {
             pairs: Vec::new(),
             sensors: BTreeSet::new(),
+            excluded: Vec::new(),
             events: Vec::new(),
             was_touching: Vec::new(),
             dead: Vec::new(),
@@ -127,7 +133,22 @@ fn new_pair<H>(a: H, b: H) -> PairContact<H> {
         manifold: ContactManifold::new(),
         touching: false,
         sensor: false,
+        excluded: false,
     }
+}
+
+/// The pair `(a, b)` in either order, as stored in [`NarrowPhase::set_excluded`]'s list.
+fn ordered<H: Ord>(a: H, b: H) -> (H, H) {
+    if a <= b {
+        (a, b)
+    } else {
+        (b, a)
+    }
+}
+
+/// True when the sorted exclusion list holds the pair `(a, b)` (either order).
+fn is_in<H: Copy + Ord>(excluded: &[(H, H)], a: H, b: H) -> bool {
+    !excluded.is_empty() && excluded.binary_search(&ordered(a, b)).is_ok()
 }
 
 impl<H: Copy + Ord + Send + Sync> NarrowPhase<H> {
@@ -156,8 +177,53 @@ impl<H: Copy + Ord + Send + Sync> NarrowPhase<H> {
     /// Creates the manifold of pair `(a, b)` (nothing when it exists).
     pub fn add_pair(&mut self, a: H, b: H) {
         if let Err(i) = self.find(a, b) {
-            self.pairs.insert(i, new_pair(a, b));
+            let mut p = new_pair(a, b);
+            p.excluded = is_in(&self.excluded, a, b);
+            self.pairs.insert(i, p);
         }
+    }
+
+    /// Excludes the pair of objects `a`, `b` (either order) from contact generation, or
+    /// lets it back in. An excluded pair stays in the pair list (the broadphase still
+    /// reports it) but is never updated: its manifold is emptied, it never touches, so it
+    /// hands no point to a solver and reports no event (an `End` at the next step if it was
+    /// touching). The exclusion applies to the pair present now and to the pair the
+    /// broadphase may add later, until it is lifted; lifted, the pair is generated afresh at
+    /// the next step. A dynamics pipeline excludes the bodies of a joint that disables their
+    /// collisions, so they never reach contact generation (Bullet's
+    /// `btCollisionObject::setIgnoreCollisionCheck`, checked by the dispatcher's
+    /// `needsCollision`; Rapier skips pairs whose joint has contacts disabled). Excluding
+    /// costs one flag test per pair and step; the exclusion list is searched only when a
+    /// pair is added.
+    pub fn set_excluded(&mut self, a: H, b: H, excluded: bool) {
+        let key = ordered(a, b);
+        match (self.excluded.binary_search(&key), excluded) {
+            (Err(i), true) => self.excluded.insert(i, key),
+            (Ok(i), false) => {
+                self.excluded.remove(i);
+            }
+            _ => {}
+        }
+        for (x, y) in [(a, b), (b, a)] {
+            if let Ok(i) = self.find(x, y) {
+                let p = &mut self.pairs[i];
+                p.excluded = excluded;
+                if excluded {
+                    // `touching` stays: the next step reports the `End`.
+                    p.manifold.clear();
+                }
+            }
+        }
+    }
+
+    /// True when the pair `a`, `b` (either order) is excluded ([`NarrowPhase::set_excluded`]).
+    pub fn is_excluded(&self, a: H, b: H) -> bool {
+        is_in(&self.excluded, a, b)
+    }
+
+    /// Lifts every exclusion that names `h` (an object that was removed).
+    pub fn clear_exclusions_of(&mut self, h: H) {
+        self.excluded.retain(|&(a, b)| a != h && b != h);
     }
 
     /// Drops the manifold of pair `(a, b)`; an `End` event is emitted if it touched.
@@ -233,7 +299,9 @@ impl<H: Copy + Ord + Send + Sync> NarrowPhase<H> {
                 self.pairs.swap(i - 1, w);
                 i -= 1;
             } else {
-                self.pairs[w] = new_pair(fa, fb);
+                let mut p = new_pair(fa, fb);
+                p.excluded = is_in(&self.excluded, fa, fb);
+                self.pairs[w] = p;
                 j -= 1;
             }
         }
@@ -259,6 +327,11 @@ impl<H: Copy + Ord + Send + Sync> NarrowPhase<H> {
         let sensors = &self.sensors;
         let update = |p: &mut PairContact<H>, was: &mut bool| -> Result<()> {
             *was = p.touching;
+            if p.excluded {
+                p.manifold.clear();
+                p.touching = false;
+                return Ok(());
+            }
             let (Some(oa), Some(ob)) = (lookup(p.a), lookup(p.b)) else {
                 return Ok(());
             };

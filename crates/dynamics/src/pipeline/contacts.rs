@@ -1,61 +1,68 @@
 //! The adapter between the narrowphase's persistent manifolds and the solver's contacts.
 //!
-//! `gather` turns every non-empty, non-sensor narrowphase manifold whose bodies should
-//! collide into a [`ContactManifold`] (normal A→B, see the module docs of
-//! [`crate::pipeline`]) in a reused buffer, carrying the accumulated impulses in;
-//! `write_back` stores the solver's impulses into the same narrowphase points afterwards.
-//! Both walk the narrowphase's manifolds in pair order, so entry `k` of the buffer maps back
-//! by its rank `sources[k].0` without any lookup table; `sources[k].1` keeps the sign that
-//! maps the second tangent impulse, so the frame is computed once per manifold.
+//! `gather` turns every non-empty, non-sensor narrowphase manifold with a dynamic body into
+//! a [`ContactManifold`] (normal A→B, see the module docs of [`crate::pipeline`]), carrying
+//! the accumulated impulses in; `write_back` stores the solver's impulses into the same
+//! narrowphase points afterwards. Pairs whose joint disables collisions never get points:
+//! the world excludes them from contact generation ([`World::create_joint`]).
+//!
+//! The buffer is overwritten in place, field by field, from step to step (no manifold is
+//! built and then moved), and entry `k` keeps the index of its narrowphase pair in
+//! `sources[k]`, so the write-back jumps from pair to pair (`Iterator::nth` on the pair
+//! slice is a pointer step) instead of walking and filtering every pair. While copying, the
+//! gather sums `0 · x` over every value it hands on (zero exactly when all are finite, the
+//! test of `DynamicsWorld`'s `plausible`), so the dynamics step need not check each manifold
+//! again.
+//!
+//! The frames need no per-manifold sign: `orthonormal_basis(n)` returns `(t₁, t₂)` with
+//! `t₁ × t₂ = n`, so for the solver's normal `n = −n_B` its second tangent `n × t₁` is
+//! `−t₂`, and the second friction impulse changes sign between the two (exact in floating
+//! point). `frame_sign_is_minus_one` checks the identity.
 
 use super::World;
 use crate::body::{mix_friction, mix_restitution, BodyType};
-use crate::contact::{ContactManifold, ContactPoint};
+use crate::contact::ContactManifold;
 use carom_collision::math::{orthonormal_basis, Real, Vec3};
-use carom_collision::narrowphase::ContactManifold as NarrowManifold;
+use carom_collision::narrowphase::ContactPoint as NarrowPoint;
+use carom_collision::world::ObjectHandle;
 
-/// The normal on B (from B towards A) of the deepest point, and the sign that maps the
-/// narrowphase's second tangent impulse to the solver's.
-fn frame(m: &NarrowManifold) -> (Vec3, Vec3, Real) {
-    let mut deepest = &m.points[0];
-    for p in &m.points[1..] {
+/// The normal on B (from B towards A) of the deepest point (the first of equally deep ones).
+#[inline]
+fn deepest_normal(points: &[NarrowPoint]) -> Vec3 {
+    let mut deepest = &points[0];
+    for p in &points[1..] {
         if p.distance < deepest.distance {
             deepest = p;
         }
     }
-    let n_b = deepest.normal;
-    let (t1, t2) = orthonormal_basis(n_b);
-    // Solver: n = -n_B, tangents (t1, n × t1).
-    let sign = t2.dot((-n_b).cross(t1)).signum();
-    (n_b, t1, sign)
+    deepest.normal
 }
 
 impl World {
-    /// Rebuilds the sorted list of body pairs whose joint disables collisions.
-    fn collect_disabled(&mut self) {
-        self.disabled.clear();
-        for (_, j) in self.dynamics.joints().iter() {
-            if j.desc.disable_collisions && !j.broken {
-                let (a, b) = (j.desc.body_a.index, j.desc.body_b.index);
-                self.disabled.push((a.min(b), a.max(b)));
-            }
-        }
-        self.disabled.sort_unstable();
-    }
-
-    /// Fills `self.contacts` from the narrowphase (see the module docs).
-    pub(super) fn gather(&mut self) {
-        self.collect_disabled();
-        self.contacts.clear();
-        self.sources.clear();
-        let set = self.dynamics.bodies();
-        for (rank, pc) in self.collision.narrowphase().manifolds().enumerate() {
-            if pc.sensor {
+    /// Fills `self.contacts` from the narrowphase (see the module docs). Returns true when
+    /// every manifold is certainly valid for the solver (the checks of
+    /// [`crate::DynamicsWorld::step`] hold), false when one may not be (the step then
+    /// validates them all and names the bad value).
+    #[inline(never)] // its own entry in profiles
+    pub(super) fn gather(&mut self) -> bool {
+        let World {
+            dynamics,
+            collision,
+            body_of,
+            contacts,
+            sources,
+            ..
+        } = self;
+        let set = dynamics.bodies();
+        let body = |o: ObjectHandle| body_of.get(o.index as usize).copied().flatten();
+        let mut k = 0;
+        let mut zero: Real = 0.0;
+        let mut ranges_ok = true;
+        for (index, pc) in collision.narrowphase().pairs().enumerate() {
+            let points = &pc.manifold.points;
+            if points.is_empty() || pc.sensor {
                 continue;
             }
-            let body = |o: carom_collision::world::ObjectHandle| {
-                self.body_of.get(o.index as usize).copied().flatten()
-            };
             let (Some(ba), Some(bb)) = (body(pc.a), body(pc.b)) else {
                 continue;
             };
@@ -64,55 +71,111 @@ impl World {
             };
             let (info_a, info_b) = (&set.info[ia], &set.info[ib]);
             let dynamic = |t: BodyType| t == BodyType::Dynamic;
-            if !(dynamic(info_a.body_type) || dynamic(info_b.body_type)) {
+            if !(dynamic(info_a.body_type) || dynamic(info_b.body_type)) || ba == bb {
                 continue;
             }
-            let key = (ba.index.min(bb.index), ba.index.max(bb.index));
-            if !self.disabled.is_empty() && self.disabled.binary_search(&key).is_ok() {
-                continue;
-            }
-            let (n_b, t1, sign) = frame(&pc.manifold);
+            let n_b = deepest_normal(points);
             if !n_b.is_finite() || (n_b.length_squared() - 1.0).abs() > 1e-3 {
                 continue;
             }
-            let mut m = ContactManifold::new(ba, bb, -n_b);
+            let (t1, _) = orthonormal_basis(n_b);
+            if k == contacts.len() {
+                contacts.push(ContactManifold::new(ba, bb, -n_b));
+                sources.push(0);
+            }
+            let m = &mut contacts[k];
+            m.body_a = ba;
+            m.body_b = bb;
+            m.normal = -n_b;
             m.tangent = t1;
             m.friction = mix_friction(info_a.friction, info_b.friction);
             m.restitution = mix_restitution(info_a.restitution, info_b.restitution);
-            for p in pc.manifold.points.iter().take(crate::MAX_MANIFOLD_POINTS) {
-                let mut q = ContactPoint::new(p.local_a, p.local_b, p.distance, p.feature);
+            zero += m.friction * 0.0;
+            ranges_ok &= m.friction >= 0.0 && (0.0..=1.0).contains(&m.restitution);
+            let mut len = 0;
+            for (q, p) in m.points.iter_mut().zip(points) {
+                q.local_a = p.local_a;
+                q.local_b = p.local_b;
+                q.separation = p.distance;
+                q.feature_id = p.feature;
                 q.normal_impulse = p.normal_impulse;
-                q.tangent_impulse = [p.tangent_impulse[0], p.tangent_impulse[1] * sign];
-                // Cannot fail: at most MAX_MANIFOLD_POINTS points are taken.
-                let _ = m.push(q);
+                q.tangent_impulse = [p.tangent_impulse[0], -p.tangent_impulse[1]];
+                zero += (p.local_a * 0.0 + p.local_b * 0.0).element_sum()
+                    + (p.distance + p.normal_impulse + p.tangent_impulse[0] + p.tangent_impulse[1])
+                        * 0.0;
+                len += 1;
             }
-            self.contacts.push(m);
-            self.sources.push((rank as u32, sign));
+            m.len = len;
+            sources[k] = index as u32;
+            k += 1;
         }
+        contacts.truncate(k);
+        sources.truncate(k);
+        zero == 0.0 && ranges_ok
     }
 
     /// Stores the solver's impulses into the narrowphase points the contacts came from.
+    #[inline(never)] // its own entry in profiles
     pub(super) fn write_back(&mut self) {
         let (contacts, sources) = (&self.contacts, &self.sources);
-        let mut k = 0;
-        for (rank, pc) in self.collision.narrowphase_mut().manifolds_mut().enumerate() {
-            if k == sources.len() {
+        let mut pairs = self.collision.narrowphase_mut().pairs_mut();
+        // Index of the next pair `pairs` yields.
+        let mut next = 0;
+        for (m, &index) in contacts.iter().zip(sources) {
+            let index = index as usize;
+            let Some(pc) = pairs.nth(index - next) else {
                 break;
-            }
-            let (source, sign) = sources[k];
-            if source as usize != rank {
-                continue;
-            }
-            for (p, q) in pc.manifold.points.iter_mut().zip(contacts[k].points()) {
+            };
+            next = index + 1;
+            for (p, q) in pc.manifold.points.iter_mut().zip(m.points()) {
                 p.normal_impulse = q.normal_impulse;
-                p.tangent_impulse = [q.tangent_impulse[0], q.tangent_impulse[1] * sign];
+                p.tangent_impulse = [q.tangent_impulse[0], -q.tangent_impulse[1]];
             }
-            k += 1;
         }
     }
 
     /// Number of contact points handed to the solver at the last step.
     pub(super) fn contact_point_count(&self) -> usize {
         self.contacts.iter().map(|m| m.points().len()).sum()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use carom_collision::math::{orthonormal_basis, Real, Vec3};
+
+    /// The solver's second tangent `(−n) × t₁` is `−t₂` for the narrowphase's basis: the
+    /// adapter maps the second friction impulse by a sign change. Normals on and near the
+    /// poles (the basis' branch), along the axes, and spread over the sphere.
+    #[test]
+    fn frame_sign_is_minus_one() {
+        let mut normals = vec![
+            Vec3::X,
+            -Vec3::X,
+            Vec3::Y,
+            -Vec3::Y,
+            Vec3::Z,
+            -Vec3::Z,
+            Vec3::new(1e-7, 0.0, -1.0).normalize(),
+            Vec3::new(0.0, 1e-7, 1.0).normalize(),
+            Vec3::new(0.0, 0.0, -0.0) + Vec3::new(0.0, 1.0, -1e-30).normalize(),
+        ];
+        for i in 0..2000 {
+            let u = (i as Real + 0.5) / 2000.0;
+            let z = 1.0 - 2.0 * u;
+            let phi = i as Real * 2.399_963;
+            let r = (1.0 - z * z).max(0.0).sqrt();
+            normals.push(Vec3::new(r * phi.cos(), r * phi.sin(), z).normalize());
+        }
+        for n_b in normals {
+            let (t1, t2) = orthonormal_basis(n_b);
+            let second = (-n_b).cross(t1);
+            assert!(
+                t2.dot(second) < -0.99 && (second + t2).length() < 1e-4,
+                "{n_b}: {t1} {t2} {second}"
+            );
+            // What the old adapter computed per manifold.
+            assert_eq!(t2.dot(second).signum(), -1.0);
+        }
     }
 }

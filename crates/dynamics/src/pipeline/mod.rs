@@ -109,11 +109,8 @@ pub struct World {
     resting: Vec<bool>,
     /// Solver contacts of the current step (reused buffer).
     contacts: Vec<ContactManifold>,
-    /// For each entry of `contacts`, its rank among the non-empty narrowphase manifolds and
-    /// the sign that maps its second tangent impulse (see `contacts.rs`).
-    sources: Vec<(u32, Real)>,
-    /// Body slot pairs (low, high) whose joint disables collisions (reused buffer).
-    disabled: Vec<(u32, u32)>,
+    /// For each entry of `contacts`, the index of its narrowphase pair (see `contacts.rs`).
+    sources: Vec<u32>,
     /// Time not yet simulated by [`World::step_simulation`].
     accumulator: Real,
     report: PipelineReport,
@@ -140,7 +137,6 @@ impl World {
             resting: Vec::new(),
             contacts: Vec::new(),
             sources: Vec::new(),
-            disabled: Vec::new(),
             accumulator: 0.0,
             report: PipelineReport::default(),
             query_cache: Default::default(),
@@ -272,14 +268,59 @@ impl World {
         Ok(())
     }
 
-    /// Creates a joint between two live bodies (see [`DynamicsWorld::create_joint`]).
+    /// Creates a joint between two live bodies (see [`DynamicsWorld::create_joint`]). With
+    /// `disable_collisions`, the pair of the two bodies' collision objects is excluded from
+    /// contact generation until the joint is removed or breaks
+    /// ([`CollisionWorld::set_pair_excluded`]).
     pub fn create_joint(&mut self, desc: &JointDesc) -> Result<JointHandle> {
-        self.dynamics.create_joint(desc)
+        let h = self.dynamics.create_joint(desc)?;
+        if desc.disable_collisions {
+            self.update_exclusion(desc.body_a, desc.body_b)?;
+        }
+        Ok(h)
     }
 
-    /// Removes a joint (wakes its bodies).
+    /// Removes a joint (wakes its bodies); their collisions come back unless another joint
+    /// still disables them.
     pub fn remove_joint(&mut self, h: JointHandle) -> Result<()> {
-        self.dynamics.remove_joint(h)
+        let desc = &self.dynamics.joints().get(h)?.desc;
+        let (a, b, disables) = (desc.body_a, desc.body_b, desc.disable_collisions);
+        self.dynamics.remove_joint(h)?;
+        if disables {
+            self.update_exclusion(a, b)?;
+        }
+        Ok(())
+    }
+
+    /// Excludes the pair of collision objects of bodies `a` and `b` from contact generation
+    /// while an unbroken joint between them disables their collisions, and lets it back in
+    /// otherwise (nothing when a body has no object). Jointed pairs thus never reach the
+    /// narrowphase: in "136 ragdolls" about 1,070 of the 3,524 broadphase pairs per step
+    /// are such pairs, which were generated in full and then dropped by the adapter.
+    fn update_exclusion(&mut self, a: BodyHandle, b: BodyHandle) -> Result<()> {
+        let (Some(oa), Some(ob)) = (self.object(a)?, self.object(b)?) else {
+            return Ok(());
+        };
+        let disabled = self.dynamics.joints().collision_disabled(a, b);
+        self.collision.set_pair_excluded(oa, ob, disabled)
+    }
+
+    /// Excludes the object pairs of every unbroken joint that disables collisions (a world
+    /// restored from a snapshot).
+    fn exclude_jointed_pairs(&mut self) -> Result<()> {
+        let pairs: Vec<(BodyHandle, BodyHandle)> = self
+            .dynamics
+            .joints()
+            .iter()
+            .filter(|(_, j)| j.desc.disable_collisions && !j.broken)
+            .map(|(_, j)| (j.desc.body_a, j.desc.body_b))
+            .collect();
+        for (a, b) in pairs {
+            if let (Some(oa), Some(ob)) = (self.object(a)?, self.object(b)?) {
+                self.collision.set_pair_excluded(oa, ob, true)?;
+            }
+        }
+        Ok(())
     }
 
     /// The report of the last [`World::step`].

@@ -377,6 +377,7 @@ fn restore(snap: Snapshot) -> Result<World> {
     for h in dead {
         world.collision.remove(h)?;
     }
+    world.exclude_jointed_pairs()?;
     world.collision.update()?;
     for o in &snap.objects {
         if let Some(h) = world.object_of[o.body as usize] {

@@ -60,14 +60,23 @@ impl World {
         let ct = self.collision.timings();
 
         let t = Instant::now();
-        self.gather();
+        let checked = self.gather();
         let gather = t.elapsed();
 
-        let dyn_report = self.dynamics.step(dt, &mut self.contacts)?;
+        let dyn_report = self
+            .dynamics
+            .step_gathered(dt, &mut self.contacts, checked)?;
 
         let t = Instant::now();
         self.write_back();
         let contacts = gather + t.elapsed();
+        // A broken joint lets its bodies collide again from the next step on.
+        for &jh in &dyn_report.broken_joints {
+            let desc = &self.dynamics.joints().get(jh)?.desc;
+            if desc.disable_collisions {
+                self.update_exclusion(desc.body_a, desc.body_b)?;
+            }
+        }
 
         let d = &dyn_report.timings;
         self.report = PipelineReport {
