@@ -224,7 +224,7 @@ pub fn contact_capsule_triangle_separated(
     }
     let (s, t, d2) = best;
     let d = d2.sqrt();
-    if !(d > tol) || !d.is_finite() {
+    if d <= tol || !d.is_finite() {
         return None;
     }
     let normal = (t - s) / d;
