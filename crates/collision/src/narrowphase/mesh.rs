@@ -146,6 +146,22 @@ impl PlaneSlab {
         })
     }
 
+    /// The slab of any shape inside the box `lo..hi` (mesh frame): a hull's placed box, whose
+    /// extent along a plane's normal bounds every vertex's (a weaker cull than the vertex scan
+    /// of the hull's own face test, at a few products instead of one dot product a vertex).
+    fn from_box(lo: Vec3, hi: Vec3) -> PlaneSlab {
+        let (p, half) = ((lo + hi) * 0.5, (hi - lo) * 0.5);
+        let tol = 1.0e-4 * (1.0 + half.x + half.y + half.z + p.abs().max_element());
+        PlaneSlab {
+            p,
+            q: p,
+            r: 0.0,
+            half,
+            axes: [Vec3::X, Vec3::Y, Vec3::Z],
+            tol,
+        }
+    }
+
     /// True when the shape lies entirely more than `prediction` (plus round-off) above or
     /// below the plane `n · x = off` (`n` unit).
     #[inline]
@@ -231,16 +247,20 @@ pub fn mesh_convex_contacts<M: ContactTriangles + ?Sized>(
     out: &mut ContactList,
 ) {
     let aabb = convex_aabb(b, pose_ab).expanded(prediction.max(0.0));
-    contacts_in_box(mesh, b, pose_ab, prediction, &aabb, tri_contacts, out);
+    let slab = PlaneSlab::new(b, pose_ab);
+    contacts_in_box(mesh, b, pose_ab, prediction, &aabb, slab, tri_contacts, out);
 }
 
-/// [`mesh_convex_contacts`] with B's box (mesh frame, expanded by the prediction) given.
+/// [`mesh_convex_contacts`] with B's box (mesh frame, expanded by the prediction) and
+/// plane cull (if any) given.
+#[allow(clippy::too_many_arguments)]
 fn contacts_in_box<M: ContactTriangles + ?Sized>(
     mesh: &M,
     b: ConvexRef<'_>,
     pose_ab: &Isometry,
     prediction: Real,
     aabb: &Aabb,
+    slab: Option<PlaneSlab>,
     tri_contacts: &mut dyn FnMut(&Triangle, &mut ContactList),
     out: &mut ContactList,
 ) {
@@ -249,7 +269,6 @@ fn contacts_in_box<M: ContactTriangles + ?Sized>(
     let mut tris: SmallVec<[u32; 64]> = SmallVec::new();
     mesh.for_each_candidate(aabb, &mut |t| tris.push(t));
     tris.sort_unstable();
-    let slab = PlaneSlab::new(b, pose_ab);
     for t in tris {
         let [p, q, r] = mesh.corners(t);
         let tri = Triangle { a: p, b: q, c: r };
@@ -287,6 +306,12 @@ fn contacts_in_box<M: ContactTriangles + ?Sized>(
 /// triangle. Given the same placed hull the contacts are those of the per-triangle
 /// `convex_convex` path bit for bit; the placement by a rotation matrix rounds differently
 /// from the quaternion's, by a few ulps.
+///
+/// The hull's box comes from its SIMD vertex lanes ([`ConvexHull::rotated_bounds`], the
+/// same box as the placed vertices', bit for bit), and the hull is placed only when some
+/// triangle survives the midphase and the box's plane cull (`PlaneSlab::from_box`, which
+/// rejects only triangles the hull's own face test rejects): most hull–mesh pairs of a
+/// falling body have no candidate triangle, and most candidates' planes pass far from it.
 pub fn mesh_hull_contacts<M: ContactTriangles + ?Sized>(
     mesh: &M,
     hull: &ConvexHull,
@@ -294,24 +319,32 @@ pub fn mesh_hull_contacts<M: ContactTriangles + ?Sized>(
     prediction: Real,
     out: &mut ContactList,
 ) {
-    let pb = Polyhedron::from_hull(hull);
-    // The hull is placed once per pair; its placed vertices also give its box (cheaper
-    // than six support queries).
-    let posed = posed_hull(&pb, pose_ab);
-    let Some(&first) = posed.vertices.first() else {
+    if hull.vertices().is_empty() {
         return;
-    };
-    let (lo, hi) = posed.vertices[1..]
-        .iter()
-        .fold((first, first), |(lo, hi), v| (lo.min(*v), hi.max(*v)));
+    }
+    let pb = Polyhedron::from_hull(hull);
+    let (lo, hi) = hull.rotated_bounds(pose_ab.rotation);
+    let (lo, hi) = (lo + pose_ab.translation, hi + pose_ab.translation);
     let aabb = Aabb::new(lo, hi).expanded(prediction.max(0.0));
+    let slab = PlaneSlab::from_box(lo, hi);
     let mut scratch = EdgeScratch::default();
+    let mut posed = None;
     let mut tri_contacts = |t: &Triangle, out: &mut ContactList| {
+        let posed = posed.get_or_insert_with(|| posed_hull(&pb, pose_ab));
         let pa = Polyhedron::from_triangle(t);
-        triangle_hull_manifold(&pa, &pb, &posed, pose_ab, prediction, &mut scratch, out);
+        triangle_hull_manifold(&pa, &pb, posed, pose_ab, prediction, &mut scratch, out);
     };
     let b = ConvexRef::ConvexHull(hull);
-    contacts_in_box(mesh, b, pose_ab, prediction, &aabb, &mut tri_contacts, out);
+    contacts_in_box(
+        mesh,
+        b,
+        pose_ab,
+        prediction,
+        &aabb,
+        Some(slab),
+        &mut tri_contacts,
+        out,
+    );
 }
 
 #[cfg(test)]

@@ -36,12 +36,14 @@ use smallvec::SmallVec;
 const PREFILTER_SIN: Real = 0.05;
 
 /// Scratch of [`triangle_hull_manifold`], reused across the triangles of a pair: per hull
-/// face, its normal's dots with the three triangle edges; the hull edges whose arcs cross
+/// face, its normal's dots with the three triangle edges and their signs (bit `k` set when
+/// dot `k` is positive, bit `k + 3` when it is negative); the hull edges whose arcs cross
 /// some triangle edge's great circle, with one bit per triangle edge. On the stack up to 64
 /// faces and 64 crossing edges.
 #[derive(Debug, Default)]
 pub(crate) struct EdgeScratch {
     dots: SmallVec<[[Real; 3]; 64]>,
+    signs: SmallVec<[u8; 64]>,
     crossing: SmallVec<[(u32, u8); 64]>,
 }
 
@@ -167,7 +169,11 @@ fn triangle_hull_edge_query(
             ok
         };
     }
-    let EdgeScratch { dots, crossing } = scratch;
+    let EdgeScratch {
+        dots,
+        signs,
+        crossing,
+    } = scratch;
     dots.clear();
     dots.extend(
         nb.iter()
@@ -175,21 +181,37 @@ fn triangle_hull_edge_query(
     );
     let dots = &dots[..];
     crossing.clear();
-    for (j, fb) in b.edge_faces().iter().enumerate() {
-        let (d0, d1) = (dots[fb[0] as usize], dots[fb[1] as usize]);
-        // Branch-free: most hull edges cross none of the three circles.
-        let mut bits = 0u8;
-        for k in 0..3 {
-            let (x, y) = (d0[k], d1[k]);
-            let one_side = if masks {
-                ((x > 0.0) & (y > 0.0)) | ((x < 0.0) & (y < 0.0))
-            } else {
-                x * y > 0.0
-            };
-            bits |= u8::from(!one_side) << k;
+    if masks {
+        // The signs once per face (not once per adjacent edge): an edge's faces lie on one
+        // side of circle `k` when both dots `k` are positive or both negative, i.e. when
+        // bit `k` or bit `k + 3` survives the AND of their sign masks.
+        signs.clear();
+        signs.extend(dots.iter().map(|d| {
+            let mut m = 0u8;
+            for (k, &x) in d.iter().enumerate() {
+                m |= (u8::from(x > 0.0) << k) | (u8::from(x < 0.0) << (k + 3));
+            }
+            m
+        }));
+        let signs = &signs[..];
+        for (j, fb) in b.edge_faces().iter().enumerate() {
+            let both = signs[fb[0] as usize] & signs[fb[1] as usize];
+            let bits = !(both | (both >> 3)) & 0b111;
+            if bits != 0 {
+                crossing.push((j as u32, bits));
+            }
         }
-        if bits != 0 {
-            crossing.push((j as u32, bits));
+    } else {
+        for (j, fb) in b.edge_faces().iter().enumerate() {
+            let (d0, d1) = (dots[fb[0] as usize], dots[fb[1] as usize]);
+            let mut bits = 0u8;
+            for k in 0..3 {
+                let one_side = d0[k] * d1[k] > 0.0;
+                bits |= u8::from(!one_side) << k;
+            }
+            if bits != 0 {
+                crossing.push((j as u32, bits));
+            }
         }
     }
     let crossing = &crossing[..];

@@ -221,13 +221,22 @@ const PRISM_TOL: Real = 1.0e-5;
 type Poly = SmallVec<[(Vec3, u32); 16]>;
 
 /// Clips the polygon `poly` (points with feature ids) against the half-space
-/// `n · x <= d`; new points get id `(start id & 0xFFFF_FF00) | tag`.
+/// `n · x <= d` (`n` need not be unit: the clip is scale-invariant); new points get id
+/// `(start id & 0xFFFF_FF00) | tag`. Each corner's signed distance is computed once (not
+/// once per adjacent edge) and the wrap-around takes no division.
 fn clip(poly: &[(Vec3, u32)], n: Vec3, d: Real, tag: u32, out: &mut Poly) {
     out.clear();
+    let Some(&(first, _)) = poly.first() else {
+        return;
+    };
+    let first_d = n.dot(first) - d;
+    let mut dp = first_d;
     for k in 0..poly.len() {
         let (p, ip) = poly[k];
-        let (q, _) = poly[(k + 1) % poly.len()];
-        let (dp, dq) = (n.dot(p) - d, n.dot(q) - d);
+        let (q, dq) = match poly.get(k + 1) {
+            Some(&(q, _)) => (q, n.dot(q) - d),
+            None => (first, first_d),
+        };
         if dp <= 0.0 {
             out.push((p, ip));
         }
@@ -235,6 +244,7 @@ fn clip(poly: &[(Vec3, u32)], n: Vec3, d: Real, tag: u32, out: &mut Poly) {
             let t = dp / (dp - dq);
             out.push((p + (q - p) * t, (ip & 0xFFFF_FF00) | (tag & 0xFF)));
         }
+        dp = dq;
     }
 }
 
@@ -267,25 +277,26 @@ pub(crate) fn clip_faces(
     }
     let id = id_base | ((inc_face as u32 & 0xFF) << 16);
     let iv = inc.vertices();
+    // The incident face's corners placed by the pose's matrix (cheaper than a quaternion
+    // rotation per corner).
+    let (m, t) = (pose_ri.rotation_matrix(), pose_ri.translation);
     let mut poly: Poly = inc
         .face_loop(inc_face)
         .iter()
         .enumerate()
-        .map(|(k, &v)| {
-            (
-                pose_ri.transform_point(iv[v as usize]),
-                id | ((k as u32 & 0xFF) << 8) | 0xFF,
-            )
-        })
+        .map(|(k, &v)| (m * iv[v as usize] + t, id | ((k as u32 & 0xFF) << 8) | 0xFF))
         .collect();
     let lp = refp.face_loop(rf);
     let rv = refp.vertices();
     let mut tmp = Poly::new();
+    let first = lp.first().map_or(0, |&v| v as usize);
+    let mut a = rv.get(first).copied().unwrap_or(Vec3::ZERO);
     for k in 0..lp.len() {
-        let a = rv[lp[k] as usize];
-        let b = rv[lp[(k + 1) % lp.len()] as usize];
-        let side = (b - a).cross(nr).normalize_or_zero();
+        let b = rv[lp.get(k + 1).map_or(first, |&v| v as usize)];
+        // Side plane through the edge, not normalised (the clip is scale-invariant).
+        let side = (b - a).cross(nr);
         clip(&poly, side, side.dot(a), k as u32, &mut tmp);
+        a = b;
         std::mem::swap(&mut poly, &mut tmp);
         if poly.is_empty() {
             break;

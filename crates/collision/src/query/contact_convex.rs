@@ -11,8 +11,8 @@
 use super::contact_capsule_cuboid::contact_capsule_cuboid;
 use super::contact_cuboid_cuboid::contact_cuboid_cuboid;
 use super::contact_round::{
-    contact_capsule_capsule, contact_sphere_capsule, contact_sphere_cuboid, contact_sphere_sphere,
-    contact_sphere_triangle,
+    contact_capsule_capsule, contact_capsule_triangle_separated, contact_sphere_capsule,
+    contact_sphere_cuboid, contact_sphere_sphere, contact_sphere_triangle,
 };
 use super::epa::{epa, epa_polytope};
 use super::gjk::{gjk, gjk_intersects, GjkResult};
@@ -35,7 +35,8 @@ pub fn swap_contact(
 
 /// Contact of two convex shapes in A's frame, or `None` when they are further apart than
 /// `prediction`. Dispatches to an exact special case when one exists (sphere–sphere,
-/// sphere–box, sphere–capsule, sphere–triangle, capsule–capsule, capsule–box, box–box) and to
+/// sphere–box, sphere–capsule, sphere–triangle, capsule–capsule, capsule–triangle (while
+/// apart), capsule–box, box–box) and to
 /// [`contact_gjk_epa`] otherwise.
 pub fn contact_convex(
     a: ConvexRef<'_>,
@@ -59,6 +60,14 @@ pub fn contact_convex(
             swap_contact(pose_ab, |p| contact_sphere_triangle(b, a, p, prediction))
         }
         (C::Capsule(a), C::Capsule(b)) => contact_capsule_capsule(a, b, pose_ab, prediction),
+        (C::Capsule(x), C::Triangle(y)) => {
+            contact_capsule_triangle_separated(x, y, pose_ab, prediction)
+                .unwrap_or_else(|| contact_gjk_epa(a, b, pose_ab, prediction))
+        }
+        (C::Triangle(x), C::Capsule(y)) => swap_contact(pose_ab, |p| {
+            contact_capsule_triangle_separated(y, x, p, prediction)
+                .unwrap_or_else(|| contact_gjk_epa(b, a, p, prediction))
+        }),
         (C::Capsule(a), C::Cuboid(b)) => contact_capsule_cuboid(a, b, pose_ab, prediction),
         (C::Cuboid(a), C::Capsule(b)) => {
             swap_contact(pose_ab, |p| contact_capsule_cuboid(b, a, p, prediction))

@@ -1,7 +1,8 @@
 //! Exact special cases for round shapes (spheres and capsules), in A's frame with B placed
-//! by `pose_ab`: sphere–sphere, sphere–box, sphere–capsule, sphere–triangle and
-//! capsule–capsule. Each reduces to the closest points between the cores (a point or a
-//! segment) and the other shape, then adds the radii — the talk's "point + radius".
+//! by `pose_ab`: sphere–sphere, sphere–box, sphere–capsule, sphere–triangle,
+//! capsule–capsule and capsule–triangle (while the segment clears the triangle). Each
+//! reduces to the closest points between the cores (a point or a segment) and the other
+//! shape, then adds the radii — the talk's "point + radius".
 
 use super::closest_points::{
     closest_point_segment, closest_point_triangle, closest_points_segment_segment,
@@ -163,6 +164,76 @@ pub fn contact_sphere_triangle(
         contact_balls(Vec3::ZERO, a.radius(), c, 0.0, -n),
         prediction,
     )
+}
+
+/// Capsule A against triangle B (two-sided) in closed form while the capsule's segment
+/// stays clear of the triangle: the closest points of a segment and a triangle are those of
+/// an endpoint and the triangle or of the segment and an edge (Ericson, "Real-Time Collision
+/// Detection", §5.1.10), so the smallest of five closest-point queries is the cores'
+/// distance, which GJK would approach iteratively. `Some(None)` beyond `prediction`;
+/// `None` when the segment meets the triangle (or comes within round-off of it) or the
+/// triangle is degenerate or a sliver: the caller then runs GJK/EPA.
+pub fn contact_capsule_triangle_separated(
+    a: &Capsule,
+    b: &Triangle,
+    pose_ab: &Isometry,
+    prediction: Real,
+) -> Option<Option<Contact>> {
+    let m = pose_ab.rotation_matrix();
+    let [t0, t1, t2] = b.vertices().map(|v| m * v + pose_ab.translation);
+    let (p, q) = a.segment();
+    let r = a.radius();
+    let size = (t1 - t0)
+        .length()
+        .max((t2 - t1).length())
+        .max((t0 - t2).length());
+    let tol = 1.0e-5 * (size + (q - p).length() + r);
+    // Slivers (area under 1e-3 of the longest edge's square: a normal no better than
+    // round-off, and barycentric closest points dividing by near zero) go to GJK/EPA.
+    let cross = (t1 - t0).cross(t2 - t0);
+    let area2 = cross.length();
+    if !(area2 > 1.0e-3 * size * size && tol > 0.0 && tol.is_finite()) {
+        return None;
+    }
+    let n = cross / area2;
+    // A segment crossing the triangle's plane inside the triangle meets it: penetration.
+    let (sp, sq) = (n.dot(p - t0), n.dot(q - t0));
+    if (sp <= tol && sq >= -tol) || (sq <= tol && sp >= -tol) {
+        if sp == sq {
+            return None;
+        }
+        let x = p + (q - p) * (sp / (sp - sq)).clamp(0.0, 1.0);
+        if (closest_point_triangle(x, t0, t1, t2) - x).length() <= tol {
+            return None;
+        }
+    }
+    let mut best = {
+        let c = closest_point_triangle(p, t0, t1, t2);
+        (p, c, (c - p).length_squared())
+    };
+    let mut take = |s: Vec3, t: Vec3| {
+        let d2 = (t - s).length_squared();
+        if d2 < best.2 {
+            best = (s, t, d2);
+        }
+    };
+    take(q, closest_point_triangle(q, t0, t1, t2));
+    for (u, v) in [(t0, t1), (t1, t2), (t2, t0)] {
+        let (s, t) = closest_points_segment_segment(p, q, u, v);
+        take(s, t);
+    }
+    let (s, t, d2) = best;
+    let d = d2.sqrt();
+    if d <= tol || !d.is_finite() {
+        return None;
+    }
+    let normal = (t - s) / d;
+    Some((d - r <= prediction).then_some(Contact {
+        distance: d - r,
+        point_a: s + normal * r,
+        point_b: t,
+        normal,
+    }))
 }
 
 #[cfg(test)]
