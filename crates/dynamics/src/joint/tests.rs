@@ -286,11 +286,10 @@ fn a_singular_block_falls_back_to_rows_and_stays_finite() {
     assert!(blocks[0].valid, "the point block has the masses");
     assert!(!blocks[1].valid, "the rotation block is singular");
     assert!(rows[3..].iter().all(|row| row.inv_k == 0.0));
-    let mut s = JointScratch {
-        joints: vec![jr],
-        rows,
-        blocks,
-    };
+    let mut s = JointScratch::default();
+    s.joints.push(jr);
+    s.rows = rows;
+    s.blocks = blocks;
     let soft = Softness::new(60.0, 2.0, 1.0 / 240.0);
     let w0: Vec<Vec3> = bodies.iter().map(|b| b.w).collect();
     for use_bias in [true, false] {
