@@ -5,11 +5,14 @@
 //! (blocks of joints; the joint overflow colour one block), then every contact colour
 //! (blocks of constraints), then the contact overflow colour (one block); solve likewise;
 //! integrate positions (blocks of bodies); refresh and relax every joint colour (each joint
-//! refreshes its rows, then solves), relax every contact colour and the overflow colour. After the last substep: restitution
-//! over the colours and the overflow colour. This is exactly the order of the sequential
-//! solve, and inside a stage the blocks touch disjoint bodies (a colour's constraints share
-//! no dynamic body; a body stage handles each body once), so the result is the same bits
-//! whatever the thread count. Block sizes are constants and never depend on the thread count.
+//! refreshes its rows, then solves), relax every contact colour and the overflow colour.
+//! After the last substep: restitution over the colours and the overflow colour. This is
+//! exactly the order of the sequential solve, and inside a stage the blocks touch disjoint
+//! bodies (a colour's constraints share no dynamic body; a body stage handles each body
+//! once), so the result is the same bits whatever the thread count. Block sizes are
+//! constants and never depend on the thread count. Consecutive contact colours too small to
+//! split (and the overflow colour) form one serial stage ([`SoftStage::Serial`]): the same
+//! order, fewer barriers.
 
 use super::coloring;
 use super::contact::{self, ContactConstraint, ContactScratch};
@@ -59,8 +62,12 @@ pub(crate) enum SoftStage {
     Joints(Pass, u8),
     /// Colour `k` (an index into the colour ranges), in blocks of constraints.
     Colour(Pass, u8),
-    /// The overflow colour, whose constraints may share bodies (one block).
-    Overflow(Pass),
+    /// Contact colours `lo..hi` one after another in one block, index `colours.len()` being
+    /// the overflow colour (whose constraints may share bodies): a run of colours that are
+    /// one block each (too small to split), fused into one stage. The order is the one of
+    /// separate one-block stages, so the bits are the same; the threads meet at one barrier
+    /// per run instead of one per colour.
+    Serial(Pass, u8, u8),
     /// Speed clamp and position update, in blocks of bodies.
     IntegratePositions,
 }
@@ -124,11 +131,33 @@ impl Shape<'_> {
                 list.push(SoftStage::Joints(pass, k), blocks);
             }
         }
+        let byte = |k: usize| u8::try_from(k).unwrap_or(u8::MAX);
+        // Start of the pending run of one-block colours.
+        let mut run: Option<usize> = None;
+        let flush = |list: &mut StageList<SoftStage>, run: &mut Option<usize>, end: usize| {
+            if let Some(start) = run.take() {
+                list.push(SoftStage::Serial(pass, byte(start), byte(end)), 1);
+            }
+        };
         for (k, r) in self.colours.iter().enumerate() {
-            let k = u8::try_from(k).unwrap_or(u8::MAX);
-            list.push(SoftStage::Colour(pass, k), self.colour_blocks(r));
+            match self.colour_blocks(r) {
+                0 => {}
+                1 => {
+                    run.get_or_insert(k);
+                }
+                blocks => {
+                    flush(list, &mut run, k);
+                    list.push(SoftStage::Colour(pass, byte(k)), blocks);
+                }
+            }
         }
-        list.push(SoftStage::Overflow(pass), usize::from(self.overflow > 0));
+        let n = self.colours.len();
+        if self.overflow > 0 {
+            run.get_or_insert(n);
+            flush(list, &mut run, n + 1);
+        } else {
+            flush(list, &mut run, n);
+        }
     }
 }
 
@@ -241,7 +270,7 @@ impl Shared<'_> {
     /// terms and poses) of their own range of terms, and every body appears in one term;
     /// contact and joint colour blocks touch their own constraints (joints: rows and blocks)
     /// and their dynamic bodies, disjoint within a colour, and only read non-dynamic bodies
-    /// and the poses; overflow stages are a single block.
+    /// and the poses; serial stages are a single block.
     unsafe fn exec(&self, kind: SoftStage, block: usize, blocks: usize) {
         let c = &self.c;
         match kind {
@@ -291,10 +320,22 @@ impl Shared<'_> {
                     self.scalar_pass(pass, range);
                 }
             }
-            SoftStage::Overflow(pass) => {
-                let range = self.overflow.clone();
-                assert!(range.end <= self.n_cons);
-                self.scalar_pass(pass, range);
+            SoftStage::Serial(pass, lo, hi) => {
+                for k in lo as usize..hi as usize {
+                    if let Some(r) = self.colours.get(k) {
+                        let items = if c.simd { self.n_wide } else { self.n_cons };
+                        assert!(r.end <= items);
+                        if c.simd {
+                            self.wide_pass(pass, r.clone());
+                        } else {
+                            self.scalar_pass(pass, r.clone());
+                        }
+                    } else {
+                        let range = self.overflow.clone();
+                        assert!(range.end <= self.n_cons);
+                        self.scalar_pass(pass, range);
+                    }
+                }
             }
         }
     }

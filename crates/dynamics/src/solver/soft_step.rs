@@ -99,14 +99,14 @@ pub(crate) fn step(ctx: &mut StepContext) {
         let slot = match kind {
             SoftStage::IntegrateVelocities => &mut ctx.timings.forces,
             SoftStage::IntegratePositions => &mut ctx.timings.integrate,
-            SoftStage::Joints(pass, _) | SoftStage::Colour(pass, _) | SoftStage::Overflow(pass) => {
-                match pass {
-                    Pass::WarmStart => &mut ctx.timings.warm_start,
-                    Pass::Solve => &mut ctx.timings.solve,
-                    Pass::Relax => &mut ctx.timings.relax,
-                    Pass::Restitution => &mut ctx.timings.restitution,
-                }
-            }
+            SoftStage::Joints(pass, _)
+            | SoftStage::Colour(pass, _)
+            | SoftStage::Serial(pass, _, _) => match pass {
+                Pass::WarmStart => &mut ctx.timings.warm_start,
+                Pass::Solve => &mut ctx.timings.solve,
+                Pass::Relax => &mut ctx.timings.relax,
+                Pass::Restitution => &mut ctx.timings.restitution,
+            },
         };
         *slot += d;
     }
