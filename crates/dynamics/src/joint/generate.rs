@@ -111,9 +111,9 @@ const INEQUALITY: fn() -> (RowKind, Real) = || (RowKind::Inequality, 0.0);
 pub(super) fn generate(kind: &JointKind, f: &Frames, h: Real, sink: &mut Sink) {
     let lock = Axis::default();
     match *kind {
-        JointKind::Ball => linear_axes(f, &[lock; 3], h, sink),
+        JointKind::Ball => locked_point(f, sink),
         JointKind::Fixed => {
-            linear_axes(f, &[lock; 3], h, sink);
+            locked_point(f, sink);
             angular_axes(f, &[lock; 3], h, sink);
         }
         JointKind::Slider { limits, motor } => {
@@ -133,7 +133,7 @@ pub(super) fn generate(kind: &JointKind, f: &Frames, h: Real, sink: &mut Sink) {
             angular_axes(f, angular, h, sink);
         }
         JointKind::Hinge { limits, motor } => {
-            linear_axes(f, &[lock; 3], h, sink);
+            locked_point(f, sink);
             hinge(f, limits, motor, h, sink);
         }
         JointKind::ConeTwist {
@@ -141,7 +141,7 @@ pub(super) fn generate(kind: &JointKind, f: &Frames, h: Real, sink: &mut Sink) {
             swing2,
             twist,
         } => {
-            linear_axes(f, &[lock; 3], h, sink);
+            locked_point(f, sink);
             cone_twist(f, swing1, swing2, twist, sink);
         }
     }
@@ -193,6 +193,16 @@ fn linear_axes(f: &Frames, axes: &[Axis; 3], h: Real, sink: &mut Sink) {
         axis_rows(3 * i, ax, value, h, sink, |s, slot, sign, c, kind| {
             s.linear(slot, axis * sign, f, c, kind)
         });
+    }
+}
+
+/// [`linear_axes`] with the three axes locked (ball, hinge, cone-twist, fixed): the same
+/// three equality rows, written without the per-axis mode dispatch.
+#[inline]
+fn locked_point(f: &Frames, sink: &mut Sink) {
+    for i in 0..3 {
+        let axis = f.axis_a(i);
+        sink.linear(3 * i, axis, f, f.d.dot(axis), EQUALITY);
     }
 }
 
