@@ -22,7 +22,7 @@
 use super::generate::{generate, Frames, Sink};
 use super::Joint;
 use crate::body_set::BodySet;
-use crate::solver::rows::{Block, Row, RowKind};
+use crate::solver::rows::{Block, PairInertia, Row, RowKind};
 use crate::solver::SolverBody;
 use carom_collision::math::{Mat3, Quat, Real, Vec3};
 use std::ops::Range;
@@ -207,17 +207,18 @@ fn masses(jr: &JointRows, rows: &mut [Row], blocks: &mut [Block], bodies: &[Solv
 /// [`masses`] on one joint's own rows and blocks.
 #[inline]
 fn masses_own(own: &mut [Row], blocks: &mut [Block], sa: &SolverBody, sb: &SolverBody) {
+    let p = PairInertia::of(sa, sb);
     let mut i = 0;
     for block in blocks {
         for row in &mut own[i..block.start] {
-            row.finish(sa, sb);
+            row.finish(&p);
         }
         let end = block.start + block.len;
-        block.update(&mut own[block.start..end], sa, sb);
+        block.update(&mut own[block.start..end], &p);
         i = end;
     }
     for row in &mut own[i..] {
-        row.finish(sa, sb);
+        row.finish(&p);
     }
 }
 

@@ -18,7 +18,7 @@ use super::rows::{Block, Motion, Row};
 use super::{Softness, SolverBody};
 use crate::body_set::BodySet;
 use crate::joint::{prepare_joint, refresh_own, JointRows, JointSet, ROW_SLOTS};
-use carom_collision::math::Real;
+use carom_collision::math::{Real, Vec3};
 use std::ops::Range;
 
 /// The joint rows of the current step, reused from step to step: one [`JointRows`] per
@@ -249,8 +249,8 @@ impl JointView {
             // the raw pointers without a reference to the whole body.
             for (p, m) in [(pa, a), (pb, b)] {
                 if (*p).dynamic {
-                    (*p).v = m.v;
-                    (*p).w = m.w;
+                    (*p).v = Vec3::from(m.v);
+                    (*p).w = Vec3::from(m.w);
                 }
             }
         }

@@ -12,15 +12,15 @@
 //! step, so applying an impulse is four scaled adds, as in the contact rows.
 
 use super::{inv_or_zero, Softness, SolverBody};
-use carom_collision::math::{Mat3, Real, Vec3};
+use carom_collision::math::{Mat3, Real, Vec3, Vec3A};
 
 /// The part of a body that solving a row reads and writes: its velocities and inverse
 /// mass (the inverse inertia is folded into each row's `ia`/`ib`). Small, so a joint's
 /// passes copy two of these rather than two whole [`SolverBody`]s.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Motion {
-    pub v: Vec3,
-    pub w: Vec3,
+    pub v: Vec3A,
+    pub w: Vec3A,
     pub inv_m: Real,
 }
 
@@ -29,8 +29,8 @@ impl Motion {
     #[inline]
     pub fn of(b: &SolverBody) -> Motion {
         Motion {
-            v: b.v,
-            w: b.w,
+            v: Vec3A::from(b.v),
+            w: Vec3A::from(b.w),
             inv_m: b.inv_m,
         }
     }
@@ -40,9 +40,48 @@ impl Motion {
     #[inline]
     pub fn store(&self, b: &mut SolverBody) {
         if b.dynamic {
-            b.v = self.v;
-            b.w = self.w;
+            b.v = Vec3::from(self.v);
+            b.w = Vec3::from(self.w);
         }
+    }
+}
+
+/// What the effective masses of a joint's rows read of its two bodies: the sum of their
+/// inverse masses and their inverse world inertias as SIMD columns, converted once per
+/// joint and refresh rather than once per row. `I⁻¹ J` is then three lane-wise
+/// multiply-adds, summed in the order of glam's `Mat3 * Vec3` (so the bits are the same).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct PairInertia {
+    /// `m_a⁻¹ + m_b⁻¹`.
+    pub inv_m: Real,
+    /// Columns of A's inverse world inertia.
+    pub a: [Vec3A; 3],
+    /// Columns of B's inverse world inertia.
+    pub b: [Vec3A; 3],
+}
+
+impl PairInertia {
+    /// The inverse masses and inertias of `a` and `b`.
+    #[inline]
+    pub fn of(a: &SolverBody, b: &SolverBody) -> PairInertia {
+        let cols = |m: &Mat3| {
+            [
+                Vec3A::from(m.x_axis),
+                Vec3A::from(m.y_axis),
+                Vec3A::from(m.z_axis),
+            ]
+        };
+        PairInertia {
+            inv_m: a.inv_m + b.inv_m,
+            a: cols(&a.inv_i),
+            b: cols(&b.inv_i),
+        }
+    }
+
+    /// `M v` for the matrix with columns `m`: `(m₀ vₓ + m₁ v_y) + m₂ v_z`.
+    #[inline]
+    pub fn mul(m: &[Vec3A; 3], v: Vec3A) -> Vec3A {
+        m[0] * v.x + m[1] * v.y + m[2] * v.z
     }
 }
 
@@ -62,13 +101,14 @@ pub(crate) enum RowKind {
 /// One prepared row.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Row {
-    /// Linear Jacobian of B (A's is `-lin`).
-    pub lin: Vec3,
-    pub ang_a: Vec3,
-    pub ang_b: Vec3,
+    /// Linear Jacobian of B (A's is `-lin`). The Jacobians are kept as [`Vec3A`] (SIMD
+    /// registers with `f32`), as are the velocities of [`Motion`].
+    pub lin: Vec3A,
+    pub ang_a: Vec3A,
+    pub ang_b: Vec3A,
     /// `I_a⁻¹ ang_a` and `I_b⁻¹ ang_b` (set by [`Row::finish`] or [`Block::update`]).
-    pub ia: Vec3,
-    pub ib: Vec3,
+    pub ia: Vec3A,
+    pub ib: Vec3A,
     pub inv_k: Real,
     pub c: Real,
     pub kind: RowKind,
@@ -93,11 +133,11 @@ impl Row {
             RowKind::Motor { .. } => (-max, max),
         };
         Row {
-            lin: j[0],
-            ang_a: j[1],
-            ang_b: j[2],
-            ia: Vec3::ZERO,
-            ib: Vec3::ZERO,
+            lin: Vec3A::from(j[0]),
+            ang_a: Vec3A::from(j[1]),
+            ang_b: Vec3A::from(j[2]),
+            ia: Vec3A::ZERO,
+            ib: Vec3A::ZERO,
             inv_k: 0.0,
             c,
             kind,
@@ -113,21 +153,20 @@ impl Row {
     /// bounds and accumulated impulse.
     #[inline]
     pub fn set(&mut self, j: [Vec3; 3], c: Real) {
-        self.lin = j[0];
-        self.ang_a = j[1];
-        self.ang_b = j[2];
+        self.lin = Vec3A::from(j[0]);
+        self.ang_a = Vec3A::from(j[1]);
+        self.ang_b = Vec3A::from(j[2]);
         self.c = c;
         self.angular = j[0] == Vec3::ZERO;
     }
 
     /// Computes the inertia-weighted angular Jacobians and the effective mass.
     #[inline]
-    pub fn finish(&mut self, a: &SolverBody, b: &SolverBody) {
-        self.ia = a.inv_i * self.ang_a;
-        self.ib = b.inv_i * self.ang_b;
-        let k = (a.inv_m + b.inv_m) * self.lin.length_squared()
-            + self.ang_a.dot(self.ia)
-            + self.ang_b.dot(self.ib);
+    pub fn finish(&mut self, p: &PairInertia) {
+        self.ia = PairInertia::mul(&p.a, self.ang_a);
+        self.ib = PairInertia::mul(&p.b, self.ang_b);
+        let k =
+            p.inv_m * self.lin.length_squared() + self.ang_a.dot(self.ia) + self.ang_b.dot(self.ib);
         self.inv_k = inv_or_zero(k);
     }
 
@@ -240,15 +279,15 @@ impl Block {
     /// Recomputes `K⁻¹` from `rows` (the block's rows, all equality rows) and their
     /// inertia-weighted Jacobians. When `K` is nearly singular the block is marked invalid
     /// and each row gets its scalar effective mass instead.
-    pub fn update(&mut self, rows: &mut [Row], a: &SolverBody, b: &SolverBody) {
+    pub fn update(&mut self, rows: &mut [Row], p: &PairInertia) {
         debug_assert_eq!(rows.len(), self.len);
         // K_ij = J_i M⁻¹ J_jᵀ: one inverse-inertia product per row, then dot products.
         for r in rows.iter_mut() {
-            r.ia = a.inv_i * r.ang_a;
-            r.ib = b.inv_i * r.ang_b;
+            r.ia = PairInertia::mul(&p.a, r.ang_a);
+            r.ib = PairInertia::mul(&p.b, r.ang_b);
         }
         // The six entries of the symmetric K, padded with the identity past `len`.
-        let inv_m = a.inv_m + b.inv_m;
+        let inv_m = p.inv_m;
         let e = |i: usize, j: usize| match (rows.get(i), rows.get(j)) {
             (Some(ri), Some(rj)) => {
                 inv_m * ri.lin.dot(rj.lin) + ri.ang_a.dot(rj.ia) + ri.ang_b.dot(rj.ib)
@@ -278,7 +317,7 @@ impl Block {
             );
         } else {
             for r in rows.iter_mut() {
-                r.finish(a, b);
+                r.finish(p);
             }
         }
     }
@@ -371,7 +410,7 @@ mod tests {
         let axis = Vec3::new(0.3, -0.8, 0.52).normalize();
         let mut row = Row::new(9, [Vec3::ZERO, -axis, axis], 0.01, RowKind::Equality, 0.0);
         assert!(row.angular);
-        row.finish(&sa, &sb);
+        row.finish(&PairInertia::of(&sa, &sb));
         let (a, b) = (Motion::of(&sa), Motion::of(&sb));
         let v = row.velocity(&a, &b);
         assert_ne!(v, 0.0);
@@ -384,7 +423,7 @@ mod tests {
         let lin = Vec3::new(0.0, 1.0, 0.0);
         row.set([lin, Vec3::X, Vec3::Y], 0.0);
         assert!(!row.angular);
-        row.finish(&sa, &sb);
+        row.finish(&PairInertia::of(&sa, &sb));
         assert_eq!(
             row.velocity(&a, &b).to_bits(),
             velocity_ref(&row, &a, &b).to_bits()
@@ -410,7 +449,7 @@ mod tests {
                     })
                     .collect();
                 let mut block = Block::new(0, n);
-                block.update(&mut rows, &sa, &sb);
+                block.update(&mut rows, &PairInertia::of(&sa, &sb));
                 assert!(block.valid);
                 let mut expected = rows.clone();
                 let (mut a, mut b) = (Motion::of(&sa), Motion::of(&sb));
