@@ -24,7 +24,7 @@ use super::Joint;
 use crate::body_set::BodySet;
 use crate::solver::rows::{Block, PairInertia, Row, RowKind};
 use crate::solver::SolverBody;
-use carom_collision::math::{Mat3, Quat, Real, Vec3};
+use carom_collision::math::{Mat3, Quat, Real, Vec3, Vec3A};
 use std::ops::Range;
 
 /// Row slots per joint: 6 axes × (lower/equality, upper, motor).
@@ -74,11 +74,16 @@ impl JointRows {
         let rb = qb * self.local_b;
         let anchor_b = pb + rb;
         let anchor_a = pa + qa * self.local_a;
+        let axes_a = Mat3::from_quat(rot_a);
         Frames {
-            ra: anchor_b - pa,
-            rb,
-            d: anchor_b - anchor_a,
-            axes_a: Mat3::from_quat(rot_a),
+            ra: Vec3A::from(anchor_b - pa),
+            rb: Vec3A::from(rb),
+            d: Vec3A::from(anchor_b - anchor_a),
+            axes_a: [
+                Vec3A::from(axes_a.x_axis),
+                Vec3A::from(axes_a.y_axis),
+                Vec3A::from(axes_a.z_axis),
+            ],
             rot_b,
             q_rel: (rot_a.conjugate() * rot_b).normalize(),
         }

@@ -126,16 +126,16 @@ impl Row {
     /// A row for `slot` with Jacobian `j = [lin, ang_a, ang_b]` and error `c`; bounds come
     /// from `kind` (`max` for motors). The effective mass is set later ([`Row::finish`] or a
     /// [`Block`]).
-    pub fn new(slot: u8, j: [Vec3; 3], c: Real, kind: RowKind, max: Real) -> Row {
+    pub fn new(slot: u8, j: [Vec3A; 3], c: Real, kind: RowKind, max: Real) -> Row {
         let (lo, hi) = match kind {
             RowKind::Equality | RowKind::Spring { .. } => (Real::NEG_INFINITY, Real::INFINITY),
             RowKind::Inequality => (0.0, Real::INFINITY),
             RowKind::Motor { .. } => (-max, max),
         };
         Row {
-            lin: Vec3A::from(j[0]),
-            ang_a: Vec3A::from(j[1]),
-            ang_b: Vec3A::from(j[2]),
+            lin: j[0],
+            ang_a: j[1],
+            ang_b: j[2],
             ia: Vec3A::ZERO,
             ib: Vec3A::ZERO,
             inv_k: 0.0,
@@ -145,19 +145,19 @@ impl Row {
             hi,
             impulse: 0.0,
             slot,
-            angular: j[0] == Vec3::ZERO,
+            angular: j[0] == Vec3A::ZERO,
         }
     }
 
     /// Replaces the Jacobian and the error (a refresh from new poses), keeping the kind,
     /// bounds and accumulated impulse.
     #[inline]
-    pub fn set(&mut self, j: [Vec3; 3], c: Real) {
-        self.lin = Vec3A::from(j[0]);
-        self.ang_a = Vec3A::from(j[1]);
-        self.ang_b = Vec3A::from(j[2]);
+    pub fn set(&mut self, j: [Vec3A; 3], c: Real) {
+        self.lin = j[0];
+        self.ang_a = j[1];
+        self.ang_b = j[2];
         self.c = c;
-        self.angular = j[0] == Vec3::ZERO;
+        self.angular = j[0] == Vec3A::ZERO;
     }
 
     /// Computes the inertia-weighted angular Jacobians and the effective mass.
@@ -407,8 +407,8 @@ mod tests {
     #[test]
     fn angular_rows_skip_only_zero_terms() {
         let (sa, sb) = (body(0.21), body(0.67));
-        let axis = Vec3::new(0.3, -0.8, 0.52).normalize();
-        let mut row = Row::new(9, [Vec3::ZERO, -axis, axis], 0.01, RowKind::Equality, 0.0);
+        let axis = Vec3A::new(0.3, -0.8, 0.52).normalize();
+        let mut row = Row::new(9, [Vec3A::ZERO, -axis, axis], 0.01, RowKind::Equality, 0.0);
         assert!(row.angular);
         row.finish(&PairInertia::of(&sa, &sb));
         let (a, b) = (Motion::of(&sa), Motion::of(&sb));
@@ -420,8 +420,8 @@ mod tests {
         apply_ref(&row, &mut a2, &mut b2, 0.37);
         assert_eq!((a1.v, a1.w, b1.v, b1.w), (a2.v, a2.w, b2.v, b2.w));
         // A refresh to a linear Jacobian clears the mark, and the linear terms count.
-        let lin = Vec3::new(0.0, 1.0, 0.0);
-        row.set([lin, Vec3::X, Vec3::Y], 0.0);
+        let lin = Vec3A::new(0.0, 1.0, 0.0);
+        row.set([lin, Vec3A::X, Vec3A::Y], 0.0);
         assert!(!row.angular);
         row.finish(&PairInertia::of(&sa, &sb));
         assert_eq!(
@@ -435,13 +435,13 @@ mod tests {
     #[test]
     fn block_solve_matches_the_coupled_formula() {
         let (sa, sb) = (body(0.13), body(0.44));
-        let (ra, rb) = (Vec3::new(0.4, -0.2, 0.1), Vec3::new(-0.3, 0.25, 0.2));
+        let (ra, rb) = (Vec3A::new(0.4, -0.2, 0.1), Vec3A::new(-0.3, 0.25, 0.2));
         let soft = Softness::new(60.0, 2.0, 1.0 / 240.0);
         for n in [2, 3] {
             for use_bias in [true, false] {
                 let mut rows: Vec<Row> = (0..n)
                     .map(|i| {
-                        let axis = [Vec3::X, Vec3::Y, Vec3::Z][i];
+                        let axis = [Vec3A::X, Vec3A::Y, Vec3A::Z][i];
                         let j = [axis, -ra.cross(axis), rb.cross(axis)];
                         let mut r = Row::new(i as u8, j, 0.01 * i as Real, RowKind::Equality, 0.0);
                         r.impulse = 0.1 * (i as Real + 1.0);
