@@ -288,15 +288,22 @@ impl Block {
         }
         // The six entries of the symmetric K, padded with the identity past `len`.
         let inv_m = p.inv_m;
-        let e = |i: usize, j: usize| match (rows.get(i), rows.get(j)) {
-            (Some(ri), Some(rj)) => {
-                inv_m * ri.lin.dot(rj.lin) + ri.ang_a.dot(rj.ia) + ri.ang_b.dot(rj.ib)
-            }
-            _ if i == j => 1.0,
-            _ => 0.0,
+        let e = |ri: &Row, rj: &Row| {
+            inv_m * ri.lin.dot(rj.lin) + ri.ang_a.dot(rj.ia) + ri.ang_b.dot(rj.ib)
         };
-        let (k00, k01, k02) = (e(0, 0), e(0, 1), e(0, 2));
-        let (k11, k12, k22) = (e(1, 1), e(1, 2), e(2, 2));
+        let (k00, k01, k02, k11, k12, k22) = match rows {
+            [r0, r1, r2] => (
+                e(r0, r0),
+                e(r0, r1),
+                e(r0, r2),
+                e(r1, r1),
+                e(r1, r2),
+                e(r2, r2),
+            ),
+            [r0, r1] => (e(r0, r0), e(r0, r1), 0.0, e(r1, r1), 0.0, 1.0),
+            [r0] => (e(r0, r0), 0.0, 0.0, 1.0, 0.0, 1.0),
+            _ => (1.0, 0.0, 0.0, 1.0, 0.0, 1.0),
+        };
         // Cofactors: K⁻¹ = C / det for a symmetric K.
         let c00 = k11 * k22 - k12 * k12;
         let c01 = k02 * k12 - k01 * k22;
