@@ -258,8 +258,9 @@ pub(crate) struct Block {
     pub start: usize,
     /// Number of rows (1..=3).
     pub len: usize,
-    /// Inverse of `K`, padded with the identity past `len` (meaningful when `valid`).
-    pub inv_k: Mat3,
+    /// Inverse of `K` as its three columns (SIMD registers, multiplied with
+    /// [`PairInertia::mul`]), padded with the identity past `len` (meaningful when `valid`).
+    pub inv_k: [Vec3A; 3],
     /// False when the last update found `K` nearly singular.
     pub valid: bool,
 }
@@ -271,7 +272,7 @@ impl Block {
         Block {
             start,
             len,
-            inv_k: Mat3::IDENTITY,
+            inv_k: [Vec3A::X, Vec3A::Y, Vec3A::Z],
             valid: false,
         }
     }
@@ -317,11 +318,11 @@ impl Block {
             let c12 = k01 * k02 - k00 * k12;
             let c22 = k00 * k11 - k01 * k01;
             let inv_det = 1.0 / det;
-            self.inv_k = Mat3::from_cols(
-                Vec3::new(c00, c01, c02) * inv_det,
-                Vec3::new(c01, c11, c12) * inv_det,
-                Vec3::new(c02, c12, c22) * inv_det,
-            );
+            self.inv_k = [
+                Vec3A::new(c00, c01, c02) * inv_det,
+                Vec3A::new(c01, c11, c12) * inv_det,
+                Vec3A::new(c02, c12, c22) * inv_det,
+            ];
         } else {
             for r in rows.iter_mut() {
                 r.finish(p);
@@ -359,8 +360,8 @@ impl Block {
         soft: Softness,
         use_bias: bool,
     ) {
-        let mut rhs = Vec3::ZERO;
-        let mut acc = Vec3::ZERO;
+        let mut rhs = Vec3A::ZERO;
+        let mut acc = Vec3A::ZERO;
         for (i, r) in rows.iter().enumerate() {
             let bias = if use_bias { soft.bias_rate * r.c } else { 0.0 };
             rhs[i] = r.velocity(a, b) + bias;
@@ -371,7 +372,7 @@ impl Block {
         } else {
             (1.0, 0.0)
         };
-        let lambda = -(self.inv_k * rhs) * mass_scale - acc * impulse_scale;
+        let lambda = -PairInertia::mul(&self.inv_k, rhs) * mass_scale - acc * impulse_scale;
         for (i, r) in rows.iter_mut().enumerate() {
             r.impulse += lambda[i];
             r.apply(a, b, lambda[i]);
@@ -468,13 +469,13 @@ mod tests {
                 } else {
                     (1.0, 0.0)
                 };
-                let (mut rhs, mut acc) = (Vec3::ZERO, Vec3::ZERO);
+                let (mut rhs, mut acc) = (Vec3A::ZERO, Vec3A::ZERO);
                 for (i, r) in expected.iter().enumerate() {
                     let bias = if use_bias { soft.bias_rate * r.c } else { 0.0 };
                     rhs[i] = velocity_ref(r, &ea, &eb) + bias;
                     acc[i] = r.impulse;
                 }
-                let lambda = -(block.inv_k * rhs) * ms - acc * is;
+                let lambda = -PairInertia::mul(&block.inv_k, rhs) * ms - acc * is;
                 for (i, r) in expected.iter_mut().enumerate() {
                     r.impulse += lambda[i];
                     apply_ref(r, &mut ea, &mut eb, lambda[i]);
