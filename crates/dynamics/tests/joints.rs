@@ -318,12 +318,10 @@ fn ragdoll_from_the_scene_comes_to_rest() {
         p.sleep.enabled = false;
         sim.world.set_params(p).unwrap();
         // Sleeping off: the ragdoll itself must settle. The sequential-impulse solver keeps a
-        // joint/contact jitter that never dies out, hence its looser bounds: since the joints
-        // are solved in colour order, its largest body speed from step 1000 to 3000 reaches
-        // 0.44 m/s and 0.99 rad/s in f64 (0.24 m/s and 0.60 rad/s at step 1800) and
-        // 0.17 m/s and 0.30 rad/s in f32 (which value step 1800 lands on depends on
-        // round-off). The soft step is at rest (from step 1000: below 1e-5 m/s and rad/s in
-        // f64, 0.013 m/s and 0.04 rad/s in f32).
+        // joint/contact jitter that never dies out: its largest body speed wanders between
+        // 0.03 and 0.19 m/s from step 1000 to 3000 (measured in f64; which value step 1800
+        // lands on depends on round-off), hence its looser bound. The soft step is at rest
+        // (below 1e-4 m/s from step 1000).
         for _ in 0..1800 {
             sim.step();
         }
@@ -338,12 +336,12 @@ fn ragdoll_from_the_scene_comes_to_rest() {
                 v.is_finite() && wv.is_finite() && p.is_finite(),
                 "{kind:?}: NaN"
             );
-            let (v_max, w_max) = match kind {
-                SolverKind::SoftStep => (0.1, 0.5),
-                SolverKind::SequentialImpulse => (0.5, 1.2),
+            let v_max = match kind {
+                SolverKind::SoftStep => 0.1,
+                SolverKind::SequentialImpulse => 0.25,
             };
             assert!(
-                v.length() < v_max && wv.length() < w_max,
+                v.length() < v_max && wv.length() < 0.5,
                 "{kind:?}: still moving {v} {wv}"
             );
             assert!(p.y > -0.05 && p.y < 2.0, "{kind:?}: body at {p}");

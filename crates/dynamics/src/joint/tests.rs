@@ -290,6 +290,7 @@ fn a_singular_block_falls_back_to_rows_and_stays_finite() {
     s.joints.push(jr);
     s.rows = rows;
     s.blocks = blocks;
+    s.order_by_slot();
     let soft = Softness::new(60.0, 2.0, 1.0 / 240.0);
     let w0: Vec<Vec3> = bodies.iter().map(|b| b.w).collect();
     for use_bias in [true, false] {

@@ -1,9 +1,10 @@
 //! Joint rows in the step: prepare, refresh, warm start, solve and store, shared by both
 //! solvers. Joints are graph-coloured like the contacts (module `coloring`, Box2D v3's
 //! constraint graph colours joints too): the joints of one colour share no dynamic body, so
-//! the soft step solves a colour in parallel blocks (module `soft_stages`), and both solvers
-//! walk the joints colour by colour, before the contacts of each iteration (Bullet solves
-//! non-contact constraints first as well). The colouring depends only on the joint set and
+//! the soft step solves a colour in parallel blocks (module `soft_stages`) and walks the
+//! joints colour by colour; sequential impulses (one thread) walk them in joint slot order.
+//! Both solve the joints before the contacts of each iteration (Bullet solves non-contact
+//! constraints first as well). The colouring depends only on the joint set and
 //! which bodies move, so the order — and every bit of the result — is the same for any
 //! thread count. Runs of equality rows (a ball joint's point, a fixed joint's rotation) are
 //! solved as coupled blocks ([`Block`]).
@@ -31,6 +32,9 @@ pub(crate) struct JointScratch {
     /// Colour ranges into `joints`; the last one is the overflow colour (possibly empty),
     /// whose joints may share bodies.
     pub colours: Vec<Range<usize>>,
+    /// Indices into `joints` in joint slot order: the order in which sequential impulses
+    /// visit them (see [`solve`]).
+    by_slot: Vec<usize>,
     /// Slots of the active joints, in slot order, and their body pairs (colouring input).
     active: Vec<usize>,
     pairs: Vec<(usize, usize)>,
@@ -87,6 +91,18 @@ pub(crate) fn prepare(
         }
         s.colours.push(start..s.joints.len());
     }
+    s.order_by_slot();
+}
+
+impl JointScratch {
+    /// Lists the prepared joints in joint slot order, the order of [`warm_start`] and
+    /// [`solve`] (done by [`prepare`]; needed again when `joints` is filled otherwise).
+    pub(crate) fn order_by_slot(&mut self) {
+        self.by_slot.clear();
+        self.by_slot.extend(0..self.joints.len());
+        let joints = &self.joints;
+        self.by_slot.sort_unstable_by_key(|&k| joints[k].joint);
+    }
 }
 
 /// Applies the accumulated impulses of one joint (`rows`: its own rows).
@@ -97,9 +113,10 @@ pub(crate) fn warm_start_joint(rows: &[Row], a: &mut Motion, b: &mut Motion) {
     }
 }
 
-/// Applies the accumulated impulses.
+/// Applies the accumulated impulses, in joint slot order (as [`solve`]).
 pub(crate) fn warm_start(s: &mut JointScratch, bodies: &mut [SolverBody]) {
-    for jr in &s.joints {
+    for &k in &s.by_slot {
+        let jr = &s.joints[k];
         let (mut a, mut b) = (Motion::of(&bodies[jr.a]), Motion::of(&bodies[jr.b]));
         warm_start_joint(&s.rows[jr.rows.clone()], &mut a, &mut b);
         write_back(bodies, jr, a, b);
@@ -145,7 +162,11 @@ pub(crate) fn solve_joint(
     }
 }
 
-/// One pass over every joint, in colour order ([`solve_joint`]).
+/// One pass over every joint ([`solve_joint`]) for sequential impulses, in joint slot order
+/// (the order of creation, typically down a ragdoll's chain): one thread, no need for the
+/// colour order, and with the Gauss–Seidel sweep in colour order (joints of one chain
+/// visited out of order) the sequential-impulse ragdoll of `tests/joints.rs` kept a jitter
+/// of 0.44 m/s, 0.99 rad/s in `f64` instead of 0.017 m/s, 0.034 rad/s.
 pub(crate) fn solve(
     s: &mut JointScratch,
     bodies: &mut [SolverBody],
@@ -153,7 +174,8 @@ pub(crate) fn solve(
     inv_h: Real,
     use_bias: bool,
 ) {
-    for jr in &s.joints {
+    for &k in &s.by_slot {
+        let jr = &s.joints[k];
         let (mut a, mut b) = (Motion::of(&bodies[jr.a]), Motion::of(&bodies[jr.b]));
         let rows = &mut s.rows[jr.rows.clone()];
         let blocks = &s.blocks[jr.blocks.clone()];
