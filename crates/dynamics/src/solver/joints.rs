@@ -91,12 +91,12 @@ pub(crate) fn prepare(
         }
         s.colours.push(start..s.joints.len());
     }
-    s.order_by_slot();
 }
 
 impl JointScratch {
     /// Lists the prepared joints in joint slot order, the order of [`warm_start`] and
-    /// [`solve`] (done by [`prepare`]; needed again when `joints` is filled otherwise).
+    /// [`solve`]: sequential impulses call it after [`prepare`] (the soft step, which walks
+    /// the colours, does not need it).
     pub(crate) fn order_by_slot(&mut self) {
         self.by_slot.clear();
         self.by_slot.extend(0..self.joints.len());
