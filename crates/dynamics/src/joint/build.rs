@@ -12,7 +12,7 @@
 //! substep solves: [`prepare_joint`] runs once per step and fixes everything that does not
 //! move — which rows exist, their kinds, bounds, slots and warm-start impulses, which runs
 //! form blocks, and the anchors and frame rotations in the bodies' centre-of-mass frames;
-//! [`refresh_joint`] runs after every position update of the soft step and only rotates the
+//! [`refresh_own`] runs after every position update of the soft step and only rotates the
 //! anchors and axes by the current body rotations, recomputes the errors, and updates the
 //! effective masses (with the step's fixed inverse inertias). Both run the same generator
 //! (module `generate`), which writes through a sink that either appends rows or overwrites
@@ -22,9 +22,9 @@
 use super::generate::{generate, Frames, Sink};
 use super::Joint;
 use crate::body_set::BodySet;
-use crate::solver::rows::{Block, Row, RowKind};
+use crate::solver::rows::{Block, PairInertia, Row, RowKind};
 use crate::solver::SolverBody;
-use carom_collision::math::{Mat3, Quat, Real, Vec3};
+use carom_collision::math::{Mat3, Quat, Real, Vec3, Vec3A};
 use std::ops::Range;
 
 /// Row slots per joint: 6 axes × (lower/equality, upper, motor).
@@ -74,11 +74,16 @@ impl JointRows {
         let rb = qb * self.local_b;
         let anchor_b = pb + rb;
         let anchor_a = pa + qa * self.local_a;
+        let axes_a = Mat3::from_quat(rot_a);
         Frames {
-            ra: anchor_b - pa,
-            rb,
-            d: anchor_b - anchor_a,
-            axes_a: Mat3::from_quat(rot_a),
+            ra: Vec3A::from(anchor_b - pa),
+            rb: Vec3A::from(rb),
+            d: Vec3A::from(anchor_b - anchor_a),
+            axes_a: [
+                Vec3A::from(axes_a.x_axis),
+                Vec3A::from(axes_a.y_axis),
+                Vec3A::from(axes_a.z_axis),
+            ],
             rot_b,
             q_rel: (rot_a.conjugate() * rot_b).normalize(),
         }
@@ -144,11 +149,8 @@ pub(crate) fn prepare_joint(
     Some(jr)
 }
 
-/// Updates the rows of `jr` from the bodies' *current* poses (the soft step moves them every
-/// substep), keeping kinds, bounds and accumulated impulses. Box2D v3 rotates the anchors by
-/// each body's delta rotation in every solve (`b2SolveRevoluteJoint`); a row built once per
-/// step keeps the lever arms and axes of the step start, a linearisation that lets the
-/// joint drift and pump energy.
+/// [`refresh_own`] on the shared buffers (tests).
+#[cfg(test)]
 pub(crate) fn refresh_joint(
     jr: &JointRows,
     joint: &Joint,
@@ -157,30 +159,71 @@ pub(crate) fn refresh_joint(
     rows: &mut [Row],
     blocks: &mut [Block],
 ) {
+    let (own, own_blocks) = (&mut rows[jr.rows.clone()], &mut blocks[jr.blocks.clone()]);
+    refresh_own(
+        jr,
+        joint,
+        set,
+        &bodies[jr.a],
+        &bodies[jr.b],
+        own,
+        own_blocks,
+    );
+}
+
+/// Updates the rows of `jr` from the bodies' *current* poses (the soft step moves them every
+/// substep), keeping kinds, bounds and accumulated impulses. Box2D v3 rotates the anchors by
+/// each body's delta rotation in every solve (`b2SolveRevoluteJoint`); a row built once per
+/// step keeps the lever arms and axes of the step start, a linearisation that lets the
+/// joint drift and pump energy.
+///
+/// Touches only the joint's two solver bodies `sa`, `sb` (read for their inverse masses and
+/// inertias) and its own rows and blocks (`own`, `own_blocks`: the ranges `jr.rows` and
+/// `jr.blocks` of the shared buffers), so the joints of one colour may be refreshed at the
+/// same time.
+pub(crate) fn refresh_own(
+    jr: &JointRows,
+    joint: &Joint,
+    set: &BodySet,
+    sa: &SolverBody,
+    sb: &SolverBody,
+    own: &mut [Row],
+    own_blocks: &mut [Block],
+) {
     let f = jr.frames(set);
-    let own = &mut rows[jr.rows.clone()];
     let mut sink = Sink::Overwrite(own, 0);
     // `h` only sizes motor bounds and spring softness, which an overwrite keeps.
     generate(&joint.desc.kind, &f, 0.0, &mut sink);
     debug_assert!(matches!(sink, Sink::Overwrite(r, n) if n == r.len()));
-    masses(jr, rows, blocks, bodies);
+    masses_own(own, own_blocks, sa, sb);
 }
 
 /// Effective masses: each block's `K⁻¹`, the scalar mass of every other row.
 fn masses(jr: &JointRows, rows: &mut [Row], blocks: &mut [Block], bodies: &[SolverBody]) {
     let (sa, sb) = (&bodies[jr.a], &bodies[jr.b]);
-    let own = &mut rows[jr.rows.clone()];
+    masses_own(
+        &mut rows[jr.rows.clone()],
+        &mut blocks[jr.blocks.clone()],
+        sa,
+        sb,
+    );
+}
+
+/// [`masses`] on one joint's own rows and blocks.
+#[inline]
+fn masses_own(own: &mut [Row], blocks: &mut [Block], sa: &SolverBody, sb: &SolverBody) {
+    let p = PairInertia::of(sa, sb);
     let mut i = 0;
-    for block in &mut blocks[jr.blocks.clone()] {
+    for block in blocks {
         for row in &mut own[i..block.start] {
-            row.finish(sa, sb);
+            row.finish(&p);
         }
         let end = block.start + block.len;
-        block.update(&mut own[block.start..end], sa, sb);
+        block.update(&mut own[block.start..end], &p);
         i = end;
     }
     for row in &mut own[i..] {
-        row.finish(sa, sb);
+        row.finish(&p);
     }
 }
 

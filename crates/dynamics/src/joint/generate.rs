@@ -9,18 +9,19 @@ use super::build::rotation_vector;
 use super::{Axis, AxisMode, JointKind, Motor};
 use crate::solver::rows::{Row, RowKind};
 use crate::solver::Softness;
-use carom_collision::math::{Mat3, Quat, Real, Vec3};
+use carom_collision::math::{Quat, Real, Vec3, Vec3A};
 
-/// The joint frames at the current poses.
+/// The joint frames at the current poses. The vectors are [`Vec3A`] (SIMD registers in
+/// `f32`), as are the rows' Jacobians they become.
 pub(super) struct Frames {
     /// Lever arm from A's centre of mass to B's anchor.
-    pub ra: Vec3,
+    pub ra: Vec3A,
     /// Lever arm from B's centre of mass to B's anchor.
-    pub rb: Vec3,
+    pub rb: Vec3A,
     /// From A's anchor to B's.
-    pub d: Vec3,
-    /// Frame A's axes in world space (columns).
-    pub axes_a: Mat3,
+    pub d: Vec3A,
+    /// Frame A's axes in world space (the columns of its rotation matrix).
+    pub axes_a: [Vec3A; 3],
     /// Frame B's rotation in world space.
     pub rot_b: Quat,
     /// `q_fa⁻¹ q_fb`, normalised.
@@ -29,8 +30,15 @@ pub(super) struct Frames {
 
 impl Frames {
     #[inline]
-    fn axis_a(&self, i: usize) -> Vec3 {
-        self.axes_a.col(i)
+    fn axis_a(&self, i: usize) -> Vec3A {
+        self.axes_a[i]
+    }
+
+    /// Frame A's rotation applied to `u` (`(x₀ u_x + x₁ u_y) + x₂ u_z`, the order of glam's
+    /// `Mat3 * Vec3`).
+    #[inline]
+    fn rotate_a(&self, u: Vec3) -> Vec3A {
+        self.axes_a[0] * u.x + self.axes_a[1] * u.y + self.axes_a[2] * u.z
     }
 }
 
@@ -45,7 +53,7 @@ impl Sink<'_> {
     /// One row for `slot` with Jacobian `j` and error `c`; `kind` gives the row kind and
     /// its motor bound, and is only evaluated when appending.
     #[inline]
-    fn put(&mut self, slot: usize, j: [Vec3; 3], c: Real, kind: impl FnOnce() -> (RowKind, Real)) {
+    fn put(&mut self, slot: usize, j: [Vec3A; 3], c: Real, kind: impl FnOnce() -> (RowKind, Real)) {
         match self {
             Sink::Append(rows) => {
                 let (kind, max) = kind();
@@ -64,7 +72,7 @@ impl Sink<'_> {
     /// zero impulse (a row that would be absent).
     #[inline]
     fn put_inactive(&mut self, slot: usize) {
-        let zero = [Vec3::ZERO; 3];
+        let zero = [Vec3A::ZERO; 3];
         match self {
             Sink::Append(rows) => {
                 rows.push(Row::new(slot as u8, zero, 0.0, RowKind::Inequality, 0.0))
@@ -83,7 +91,7 @@ impl Sink<'_> {
     fn linear(
         &mut self,
         slot: usize,
-        axis: Vec3,
+        axis: Vec3A,
         f: &Frames,
         c: Real,
         kind: impl FnOnce() -> (RowKind, Real),
@@ -96,11 +104,11 @@ impl Sink<'_> {
     fn angular(
         &mut self,
         slot: usize,
-        axis: Vec3,
+        axis: Vec3A,
         c: Real,
         kind: impl FnOnce() -> (RowKind, Real),
     ) {
-        self.put(slot, [Vec3::ZERO, -axis, axis], c, kind);
+        self.put(slot, [Vec3A::ZERO, -axis, axis], c, kind);
     }
 }
 
@@ -111,9 +119,9 @@ const INEQUALITY: fn() -> (RowKind, Real) = || (RowKind::Inequality, 0.0);
 pub(super) fn generate(kind: &JointKind, f: &Frames, h: Real, sink: &mut Sink) {
     let lock = Axis::default();
     match *kind {
-        JointKind::Ball => linear_axes(f, &[lock; 3], h, sink),
+        JointKind::Ball => locked_point(f, sink),
         JointKind::Fixed => {
-            linear_axes(f, &[lock; 3], h, sink);
+            locked_point(f, sink);
             angular_axes(f, &[lock; 3], h, sink);
         }
         JointKind::Slider { limits, motor } => {
@@ -133,7 +141,7 @@ pub(super) fn generate(kind: &JointKind, f: &Frames, h: Real, sink: &mut Sink) {
             angular_axes(f, angular, h, sink);
         }
         JointKind::Hinge { limits, motor } => {
-            linear_axes(f, &[lock; 3], h, sink);
+            locked_point(f, sink);
             hinge(f, limits, motor, h, sink);
         }
         JointKind::ConeTwist {
@@ -141,7 +149,7 @@ pub(super) fn generate(kind: &JointKind, f: &Frames, h: Real, sink: &mut Sink) {
             swing2,
             twist,
         } => {
-            linear_axes(f, &[lock; 3], h, sink);
+            locked_point(f, sink);
             cone_twist(f, swing1, swing2, twist, sink);
         }
     }
@@ -196,6 +204,16 @@ fn linear_axes(f: &Frames, axes: &[Axis; 3], h: Real, sink: &mut Sink) {
     }
 }
 
+/// [`linear_axes`] with the three axes locked (ball, hinge, cone-twist, fixed): the same
+/// three equality rows, written without the per-axis mode dispatch.
+#[inline]
+fn locked_point(f: &Frames, sink: &mut Sink) {
+    for i in 0..3 {
+        let axis = f.axis_a(i);
+        sink.linear(3 * i, axis, f, f.d.dot(axis), EQUALITY);
+    }
+}
+
 fn angular_axes(f: &Frames, axes: &[Axis; 3], h: Real, sink: &mut Sink) {
     let e = rotation_vector(f.q_rel);
     for (i, ax) in axes.iter().enumerate() {
@@ -210,7 +228,7 @@ fn angular_axes(f: &Frames, axes: &[Axis; 3], h: Real, sink: &mut Sink) {
 /// rotation about `pᵢ`), then limits and motor on the angle of B's X axis in A's XY plane.
 fn hinge(f: &Frames, limits: Option<(Real, Real)>, motor: Option<Motor>, h: Real, sink: &mut Sink) {
     let za = f.axis_a(2);
-    let zb = f.rot_b * Vec3::Z;
+    let zb = Vec3A::from(f.rot_b * Vec3::Z);
     let err = za.cross(zb);
     for i in 0..2 {
         let p = f.axis_a(i);
@@ -267,13 +285,13 @@ fn cone_twist(f: &Frames, swing1: Real, swing2: Real, twist: Real, sink: &mut Si
         } else {
             s1.max(s2)
         };
-        let axis = f.axes_a * u;
+        let axis = f.rotate_a(u);
         sink.angular(9, -axis, phi_max - phi, INEQUALITY);
     } else {
         sink.put_inactive(9);
     }
-    let tw = (f.axis_a(0) + f.rot_b * Vec3::X).normalize_or_zero();
-    if tw != Vec3::ZERO {
+    let tw = (f.axis_a(0) + Vec3A::from(f.rot_b * Vec3::X)).normalize_or_zero();
+    if tw != Vec3A::ZERO {
         sink.angular(12, tw, twist_angle + twist, INEQUALITY);
         sink.angular(13, -tw, twist - twist_angle, INEQUALITY);
     } else {

@@ -11,7 +11,7 @@ use crate::body_set::{BodyHandle, BodySet};
 use crate::integrate;
 use crate::solver::rows::{Block, Row};
 use crate::solver::SolverBody;
-use carom_collision::math::{Isometry, Quat, Real, Vec3};
+use carom_collision::math::{Isometry, Quat, Real, Vec3, Vec3A};
 use carom_collision::shape::{ConvexHull, Shape};
 use std::sync::Arc;
 
@@ -233,7 +233,7 @@ fn cone_rows_are_inactive_where_their_axes_are_undefined() {
     // No swing at the start: the swing row (slot 9) has no axis.
     let (jr, mut rows, mut blocks) = prepare(&r, &bodies);
     let swing = rows.iter().position(|row| row.slot == 9).unwrap();
-    assert_eq!(rows[swing].ang_b, Vec3::ZERO);
+    assert_eq!(rows[swing].ang_b, Vec3A::ZERO);
     assert_eq!((rows[swing].inv_k, rows[swing].impulse), (0.0, 0.0));
     // A swing about frame A's Y axis (world: rotated by A's and the frame's rotation).
     let fa = r
@@ -256,7 +256,7 @@ fn cone_rows_are_inactive_where_their_axes_are_undefined() {
             .normalize();
     let (_, j) = r.joints.iter().next().unwrap();
     refresh_joint(&jr, j, &r.set, &bodies, &mut rows, &mut blocks);
-    assert_eq!(rows[swing].ang_b, Vec3::ZERO);
+    assert_eq!(rows[swing].ang_b, Vec3A::ZERO);
     assert_eq!((rows[swing].inv_k, rows[swing].impulse), (0.0, 0.0));
     let (_, fresh, _) = prepare(&r, &bodies);
     assert_same_rows(&fresh, &rows, "back to no swing");
@@ -286,11 +286,11 @@ fn a_singular_block_falls_back_to_rows_and_stays_finite() {
     assert!(blocks[0].valid, "the point block has the masses");
     assert!(!blocks[1].valid, "the rotation block is singular");
     assert!(rows[3..].iter().all(|row| row.inv_k == 0.0));
-    let mut s = JointScratch {
-        joints: vec![jr],
-        rows,
-        blocks,
-    };
+    let mut s = JointScratch::default();
+    s.joints.push(jr);
+    s.rows = rows;
+    s.blocks = blocks;
+    s.order_by_slot();
     let soft = Softness::new(60.0, 2.0, 1.0 / 240.0);
     let w0: Vec<Vec3> = bodies.iter().map(|b| b.w).collect();
     for use_bias in [true, false] {

@@ -12,15 +12,15 @@
 //! step, so applying an impulse is four scaled adds, as in the contact rows.
 
 use super::{inv_or_zero, Softness, SolverBody};
-use carom_collision::math::{Mat3, Real, Vec3};
+use carom_collision::math::{Mat3, Real, Vec3, Vec3A};
 
 /// The part of a body that solving a row reads and writes: its velocities and inverse
 /// mass (the inverse inertia is folded into each row's `ia`/`ib`). Small, so a joint's
 /// passes copy two of these rather than two whole [`SolverBody`]s.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Motion {
-    pub v: Vec3,
-    pub w: Vec3,
+    pub v: Vec3A,
+    pub w: Vec3A,
     pub inv_m: Real,
 }
 
@@ -29,8 +29,8 @@ impl Motion {
     #[inline]
     pub fn of(b: &SolverBody) -> Motion {
         Motion {
-            v: b.v,
-            w: b.w,
+            v: Vec3A::from(b.v),
+            w: Vec3A::from(b.w),
             inv_m: b.inv_m,
         }
     }
@@ -40,9 +40,48 @@ impl Motion {
     #[inline]
     pub fn store(&self, b: &mut SolverBody) {
         if b.dynamic {
-            b.v = self.v;
-            b.w = self.w;
+            b.v = Vec3::from(self.v);
+            b.w = Vec3::from(self.w);
         }
+    }
+}
+
+/// What the effective masses of a joint's rows read of its two bodies: the sum of their
+/// inverse masses and their inverse world inertias as SIMD columns, converted once per
+/// joint and refresh rather than once per row. `I⁻¹ J` is then three lane-wise
+/// multiply-adds, summed in the order of glam's `Mat3 * Vec3` (so the bits are the same).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct PairInertia {
+    /// `m_a⁻¹ + m_b⁻¹`.
+    pub inv_m: Real,
+    /// Columns of A's inverse world inertia.
+    pub a: [Vec3A; 3],
+    /// Columns of B's inverse world inertia.
+    pub b: [Vec3A; 3],
+}
+
+impl PairInertia {
+    /// The inverse masses and inertias of `a` and `b`.
+    #[inline]
+    pub fn of(a: &SolverBody, b: &SolverBody) -> PairInertia {
+        let cols = |m: &Mat3| {
+            [
+                Vec3A::from(m.x_axis),
+                Vec3A::from(m.y_axis),
+                Vec3A::from(m.z_axis),
+            ]
+        };
+        PairInertia {
+            inv_m: a.inv_m + b.inv_m,
+            a: cols(&a.inv_i),
+            b: cols(&b.inv_i),
+        }
+    }
+
+    /// `M v` for the matrix with columns `m`: `(m₀ vₓ + m₁ v_y) + m₂ v_z`.
+    #[inline]
+    pub fn mul(m: &[Vec3A; 3], v: Vec3A) -> Vec3A {
+        m[0] * v.x + m[1] * v.y + m[2] * v.z
     }
 }
 
@@ -62,13 +101,14 @@ pub(crate) enum RowKind {
 /// One prepared row.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Row {
-    /// Linear Jacobian of B (A's is `-lin`).
-    pub lin: Vec3,
-    pub ang_a: Vec3,
-    pub ang_b: Vec3,
+    /// Linear Jacobian of B (A's is `-lin`). The Jacobians are kept as [`Vec3A`] (SIMD
+    /// registers with `f32`), as are the velocities of [`Motion`].
+    pub lin: Vec3A,
+    pub ang_a: Vec3A,
+    pub ang_b: Vec3A,
     /// `I_a⁻¹ ang_a` and `I_b⁻¹ ang_b` (set by [`Row::finish`] or [`Block::update`]).
-    pub ia: Vec3,
-    pub ib: Vec3,
+    pub ia: Vec3A,
+    pub ib: Vec3A,
     pub inv_k: Real,
     pub c: Real,
     pub kind: RowKind,
@@ -86,7 +126,7 @@ impl Row {
     /// A row for `slot` with Jacobian `j = [lin, ang_a, ang_b]` and error `c`; bounds come
     /// from `kind` (`max` for motors). The effective mass is set later ([`Row::finish`] or a
     /// [`Block`]).
-    pub fn new(slot: u8, j: [Vec3; 3], c: Real, kind: RowKind, max: Real) -> Row {
+    pub fn new(slot: u8, j: [Vec3A; 3], c: Real, kind: RowKind, max: Real) -> Row {
         let (lo, hi) = match kind {
             RowKind::Equality | RowKind::Spring { .. } => (Real::NEG_INFINITY, Real::INFINITY),
             RowKind::Inequality => (0.0, Real::INFINITY),
@@ -96,8 +136,8 @@ impl Row {
             lin: j[0],
             ang_a: j[1],
             ang_b: j[2],
-            ia: Vec3::ZERO,
-            ib: Vec3::ZERO,
+            ia: Vec3A::ZERO,
+            ib: Vec3A::ZERO,
             inv_k: 0.0,
             c,
             kind,
@@ -105,29 +145,28 @@ impl Row {
             hi,
             impulse: 0.0,
             slot,
-            angular: j[0] == Vec3::ZERO,
+            angular: j[0] == Vec3A::ZERO,
         }
     }
 
     /// Replaces the Jacobian and the error (a refresh from new poses), keeping the kind,
     /// bounds and accumulated impulse.
     #[inline]
-    pub fn set(&mut self, j: [Vec3; 3], c: Real) {
+    pub fn set(&mut self, j: [Vec3A; 3], c: Real) {
         self.lin = j[0];
         self.ang_a = j[1];
         self.ang_b = j[2];
         self.c = c;
-        self.angular = j[0] == Vec3::ZERO;
+        self.angular = j[0] == Vec3A::ZERO;
     }
 
     /// Computes the inertia-weighted angular Jacobians and the effective mass.
     #[inline]
-    pub fn finish(&mut self, a: &SolverBody, b: &SolverBody) {
-        self.ia = a.inv_i * self.ang_a;
-        self.ib = b.inv_i * self.ang_b;
-        let k = (a.inv_m + b.inv_m) * self.lin.length_squared()
-            + self.ang_a.dot(self.ia)
-            + self.ang_b.dot(self.ib);
+    pub fn finish(&mut self, p: &PairInertia) {
+        self.ia = PairInertia::mul(&p.a, self.ang_a);
+        self.ib = PairInertia::mul(&p.b, self.ang_b);
+        let k =
+            p.inv_m * self.lin.length_squared() + self.ang_a.dot(self.ia) + self.ang_b.dot(self.ib);
         self.inv_k = inv_or_zero(k);
     }
 
@@ -219,8 +258,9 @@ pub(crate) struct Block {
     pub start: usize,
     /// Number of rows (1..=3).
     pub len: usize,
-    /// Inverse of `K`, padded with the identity past `len` (meaningful when `valid`).
-    pub inv_k: Mat3,
+    /// Inverse of `K` as its three columns (SIMD registers, multiplied with
+    /// [`PairInertia::mul`]), padded with the identity past `len` (meaningful when `valid`).
+    pub inv_k: [Vec3A; 3],
     /// False when the last update found `K` nearly singular.
     pub valid: bool,
 }
@@ -232,7 +272,7 @@ impl Block {
         Block {
             start,
             len,
-            inv_k: Mat3::IDENTITY,
+            inv_k: [Vec3A::X, Vec3A::Y, Vec3A::Z],
             valid: false,
         }
     }
@@ -240,24 +280,31 @@ impl Block {
     /// Recomputes `K⁻¹` from `rows` (the block's rows, all equality rows) and their
     /// inertia-weighted Jacobians. When `K` is nearly singular the block is marked invalid
     /// and each row gets its scalar effective mass instead.
-    pub fn update(&mut self, rows: &mut [Row], a: &SolverBody, b: &SolverBody) {
+    pub fn update(&mut self, rows: &mut [Row], p: &PairInertia) {
         debug_assert_eq!(rows.len(), self.len);
         // K_ij = J_i M⁻¹ J_jᵀ: one inverse-inertia product per row, then dot products.
         for r in rows.iter_mut() {
-            r.ia = a.inv_i * r.ang_a;
-            r.ib = b.inv_i * r.ang_b;
+            r.ia = PairInertia::mul(&p.a, r.ang_a);
+            r.ib = PairInertia::mul(&p.b, r.ang_b);
         }
         // The six entries of the symmetric K, padded with the identity past `len`.
-        let inv_m = a.inv_m + b.inv_m;
-        let e = |i: usize, j: usize| match (rows.get(i), rows.get(j)) {
-            (Some(ri), Some(rj)) => {
-                inv_m * ri.lin.dot(rj.lin) + ri.ang_a.dot(rj.ia) + ri.ang_b.dot(rj.ib)
-            }
-            _ if i == j => 1.0,
-            _ => 0.0,
+        let inv_m = p.inv_m;
+        let e = |ri: &Row, rj: &Row| {
+            inv_m * ri.lin.dot(rj.lin) + ri.ang_a.dot(rj.ia) + ri.ang_b.dot(rj.ib)
         };
-        let (k00, k01, k02) = (e(0, 0), e(0, 1), e(0, 2));
-        let (k11, k12, k22) = (e(1, 1), e(1, 2), e(2, 2));
+        let (k00, k01, k02, k11, k12, k22) = match rows {
+            [r0, r1, r2] => (
+                e(r0, r0),
+                e(r0, r1),
+                e(r0, r2),
+                e(r1, r1),
+                e(r1, r2),
+                e(r2, r2),
+            ),
+            [r0, r1] => (e(r0, r0), e(r0, r1), 0.0, e(r1, r1), 0.0, 1.0),
+            [r0] => (e(r0, r0), 0.0, 0.0, 1.0, 0.0, 1.0),
+            _ => (1.0, 0.0, 0.0, 1.0, 0.0, 1.0),
+        };
         // Cofactors: K⁻¹ = C / det for a symmetric K.
         let c00 = k11 * k22 - k12 * k12;
         let c01 = k02 * k12 - k01 * k22;
@@ -271,14 +318,14 @@ impl Block {
             let c12 = k01 * k02 - k00 * k12;
             let c22 = k00 * k11 - k01 * k01;
             let inv_det = 1.0 / det;
-            self.inv_k = Mat3::from_cols(
-                Vec3::new(c00, c01, c02) * inv_det,
-                Vec3::new(c01, c11, c12) * inv_det,
-                Vec3::new(c02, c12, c22) * inv_det,
-            );
+            self.inv_k = [
+                Vec3A::new(c00, c01, c02) * inv_det,
+                Vec3A::new(c01, c11, c12) * inv_det,
+                Vec3A::new(c02, c12, c22) * inv_det,
+            ];
         } else {
             for r in rows.iter_mut() {
-                r.finish(a, b);
+                r.finish(p);
             }
         }
     }
@@ -313,8 +360,8 @@ impl Block {
         soft: Softness,
         use_bias: bool,
     ) {
-        let mut rhs = Vec3::ZERO;
-        let mut acc = Vec3::ZERO;
+        let mut rhs = Vec3A::ZERO;
+        let mut acc = Vec3A::ZERO;
         for (i, r) in rows.iter().enumerate() {
             let bias = if use_bias { soft.bias_rate * r.c } else { 0.0 };
             rhs[i] = r.velocity(a, b) + bias;
@@ -325,7 +372,7 @@ impl Block {
         } else {
             (1.0, 0.0)
         };
-        let lambda = -(self.inv_k * rhs) * mass_scale - acc * impulse_scale;
+        let lambda = -PairInertia::mul(&self.inv_k, rhs) * mass_scale - acc * impulse_scale;
         for (i, r) in rows.iter_mut().enumerate() {
             r.impulse += lambda[i];
             r.apply(a, b, lambda[i]);
@@ -368,10 +415,10 @@ mod tests {
     #[test]
     fn angular_rows_skip_only_zero_terms() {
         let (sa, sb) = (body(0.21), body(0.67));
-        let axis = Vec3::new(0.3, -0.8, 0.52).normalize();
-        let mut row = Row::new(9, [Vec3::ZERO, -axis, axis], 0.01, RowKind::Equality, 0.0);
+        let axis = Vec3A::new(0.3, -0.8, 0.52).normalize();
+        let mut row = Row::new(9, [Vec3A::ZERO, -axis, axis], 0.01, RowKind::Equality, 0.0);
         assert!(row.angular);
-        row.finish(&sa, &sb);
+        row.finish(&PairInertia::of(&sa, &sb));
         let (a, b) = (Motion::of(&sa), Motion::of(&sb));
         let v = row.velocity(&a, &b);
         assert_ne!(v, 0.0);
@@ -381,10 +428,10 @@ mod tests {
         apply_ref(&row, &mut a2, &mut b2, 0.37);
         assert_eq!((a1.v, a1.w, b1.v, b1.w), (a2.v, a2.w, b2.v, b2.w));
         // A refresh to a linear Jacobian clears the mark, and the linear terms count.
-        let lin = Vec3::new(0.0, 1.0, 0.0);
-        row.set([lin, Vec3::X, Vec3::Y], 0.0);
+        let lin = Vec3A::new(0.0, 1.0, 0.0);
+        row.set([lin, Vec3A::X, Vec3A::Y], 0.0);
         assert!(!row.angular);
-        row.finish(&sa, &sb);
+        row.finish(&PairInertia::of(&sa, &sb));
         assert_eq!(
             row.velocity(&a, &b).to_bits(),
             velocity_ref(&row, &a, &b).to_bits()
@@ -396,13 +443,13 @@ mod tests {
     #[test]
     fn block_solve_matches_the_coupled_formula() {
         let (sa, sb) = (body(0.13), body(0.44));
-        let (ra, rb) = (Vec3::new(0.4, -0.2, 0.1), Vec3::new(-0.3, 0.25, 0.2));
+        let (ra, rb) = (Vec3A::new(0.4, -0.2, 0.1), Vec3A::new(-0.3, 0.25, 0.2));
         let soft = Softness::new(60.0, 2.0, 1.0 / 240.0);
         for n in [2, 3] {
             for use_bias in [true, false] {
                 let mut rows: Vec<Row> = (0..n)
                     .map(|i| {
-                        let axis = [Vec3::X, Vec3::Y, Vec3::Z][i];
+                        let axis = [Vec3A::X, Vec3A::Y, Vec3A::Z][i];
                         let j = [axis, -ra.cross(axis), rb.cross(axis)];
                         let mut r = Row::new(i as u8, j, 0.01 * i as Real, RowKind::Equality, 0.0);
                         r.impulse = 0.1 * (i as Real + 1.0);
@@ -410,7 +457,7 @@ mod tests {
                     })
                     .collect();
                 let mut block = Block::new(0, n);
-                block.update(&mut rows, &sa, &sb);
+                block.update(&mut rows, &PairInertia::of(&sa, &sb));
                 assert!(block.valid);
                 let mut expected = rows.clone();
                 let (mut a, mut b) = (Motion::of(&sa), Motion::of(&sb));
@@ -422,13 +469,13 @@ mod tests {
                 } else {
                     (1.0, 0.0)
                 };
-                let (mut rhs, mut acc) = (Vec3::ZERO, Vec3::ZERO);
+                let (mut rhs, mut acc) = (Vec3A::ZERO, Vec3A::ZERO);
                 for (i, r) in expected.iter().enumerate() {
                     let bias = if use_bias { soft.bias_rate * r.c } else { 0.0 };
                     rhs[i] = velocity_ref(r, &ea, &eb) + bias;
                     acc[i] = r.impulse;
                 }
-                let lambda = -(block.inv_k * rhs) * ms - acc * is;
+                let lambda = -PairInertia::mul(&block.inv_k, rhs) * ms - acc * is;
                 for (i, r) in expected.iter_mut().enumerate() {
                     r.impulse += lambda[i];
                     apply_ref(r, &mut ea, &mut eb, lambda[i]);

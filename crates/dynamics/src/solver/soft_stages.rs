@@ -1,19 +1,23 @@
 //! The soft step's stage list and the executor of its blocks (Box2D v3's `b2SolverStage_*`
 //! values and `b2ExecuteBlock`), run by module `stages`.
 //!
-//! Per substep: integrate velocities (blocks of bodies); warm start the joints (one block),
-//! then every colour (blocks of constraints), then the overflow colour (one block); solve
-//! likewise; integrate positions (blocks of bodies); refresh and relax the joints (one
-//! block), relax every colour and the overflow colour. After the last substep: restitution
-//! over the colours and the overflow colour. This is exactly the order of the sequential
-//! solve, and inside a stage the blocks touch disjoint bodies (a colour's constraints share
-//! no dynamic body; a body stage handles each body once), so the result is the same bits
-//! whatever the thread count. Block sizes are constants and never depend on the thread count.
+//! Per substep: integrate velocities (blocks of bodies); warm start every joint colour
+//! (blocks of joints; the joint overflow colour one block), then every contact colour
+//! (blocks of constraints), then the contact overflow colour (one block); solve likewise;
+//! integrate positions (blocks of bodies); refresh and relax every joint colour (each joint
+//! refreshes its rows, then solves), relax every contact colour and the overflow colour.
+//! After the last substep: restitution over the colours and the overflow colour. This is
+//! exactly the order of the sequential solve, and inside a stage the blocks touch disjoint
+//! bodies (a colour's constraints share no dynamic body; a body stage handles each body
+//! once), so the result is the same bits whatever the thread count. Block sizes are
+//! constants and never depend on the thread count. Consecutive contact colours too small to
+//! split (and the overflow colour) form one serial stage ([`SoftStage::Serial`]): the same
+//! order, fewer barriers.
 
 use super::coloring;
 use super::contact::{self, ContactConstraint, ContactScratch};
 use super::contact_simd::{self, WideBody, WideConstraint};
-use super::joints::{self, JointScratch};
+use super::joints::{JointPass, JointScratch, JointView};
 use super::stages::{block_count, block_range, StageList};
 use super::{Softness, SolverBody};
 use crate::body_set::BodySet;
@@ -28,6 +32,12 @@ pub(crate) const BODY_BLOCK: usize = 128;
 pub(crate) const WIDE_BLOCK: usize = 16;
 /// Scalar constraints per block of a colour stage (SIMD off).
 pub(crate) const SCALAR_BLOCK: usize = 64;
+/// Joints per block of a joint colour stage.
+pub(crate) const JOINT_BLOCK: usize = 32;
+/// Scalar constraints a joint counts as when its colour is compared with
+/// [`super::SolverParams`]'s `parallel_min_batch` (a ragdoll joint has six or seven rows,
+/// refreshed and solved, several times a contact's work).
+const JOINT_WEIGHT: usize = 8;
 
 /// A contact or joint pass.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -47,12 +57,17 @@ pub(crate) enum Pass {
 pub(crate) enum SoftStage {
     /// Gravity, forces, damping and the gyroscopic term, in blocks of bodies.
     IntegrateVelocities,
-    /// Every joint, in slot order (one block).
-    Joints(Pass),
+    /// Joint colour `k` (an index into the joint colour ranges, the last one the joint
+    /// overflow colour, which is one block), in blocks of joints.
+    Joints(Pass, u8),
     /// Colour `k` (an index into the colour ranges), in blocks of constraints.
     Colour(Pass, u8),
-    /// The overflow colour, whose constraints may share bodies (one block).
-    Overflow(Pass),
+    /// Contact colours `lo..hi` one after another in one block, index `colours.len()` being
+    /// the overflow colour (whose constraints may share bodies): a run of colours that are
+    /// one block each (too small to split), fused into one stage. The order is the one of
+    /// separate one-block stages, so the bits are the same; the threads meet at one barrier
+    /// per run instead of one per colour.
+    Serial(Pass, u8, u8),
     /// Speed clamp and position update, in blocks of bodies.
     IntegratePositions,
 }
@@ -61,8 +76,8 @@ pub(crate) enum SoftStage {
 pub(crate) struct Shape<'a> {
     pub substeps: u32,
     pub warm_starting: bool,
-    /// Whether there are joint rows.
-    pub joints: bool,
+    /// Joint colour ranges, the last one the overflow colour.
+    pub joint_colours: &'a [Range<usize>],
     /// Colour ranges (wide constraints with SIMD, scalar ones without), overflow excluded.
     pub colours: &'a [Range<usize>],
     /// Scalar constraints per item of `colours` (4 with SIMD, else 1).
@@ -88,6 +103,17 @@ impl Shape<'_> {
         }
     }
 
+    /// Blocks of joint colour `k`.
+    fn joint_blocks(&self, k: usize, r: &Range<usize>) -> usize {
+        if r.is_empty() {
+            0
+        } else if k + 1 == self.joint_colours.len() || r.len() * JOINT_WEIGHT < self.min_batch {
+            1
+        } else {
+            block_count(r.len(), JOINT_BLOCK)
+        }
+    }
+
     fn item_block(&self) -> usize {
         if self.lanes > 1 {
             WIDE_BLOCK
@@ -99,13 +125,39 @@ impl Shape<'_> {
     /// The contact and joint stages of one pass.
     fn pass(&self, list: &mut StageList<SoftStage>, pass: Pass) {
         if pass != Pass::Restitution {
-            list.push(SoftStage::Joints(pass), usize::from(self.joints));
+            for (k, r) in self.joint_colours.iter().enumerate() {
+                let blocks = self.joint_blocks(k, r);
+                let k = u8::try_from(k).unwrap_or(u8::MAX);
+                list.push(SoftStage::Joints(pass, k), blocks);
+            }
         }
+        let byte = |k: usize| u8::try_from(k).unwrap_or(u8::MAX);
+        // Start of the pending run of one-block colours.
+        let mut run: Option<usize> = None;
+        let flush = |list: &mut StageList<SoftStage>, run: &mut Option<usize>, end: usize| {
+            if let Some(start) = run.take() {
+                list.push(SoftStage::Serial(pass, byte(start), byte(end)), 1);
+            }
+        };
         for (k, r) in self.colours.iter().enumerate() {
-            let k = u8::try_from(k).unwrap_or(u8::MAX);
-            list.push(SoftStage::Colour(pass, k), self.colour_blocks(r));
+            match self.colour_blocks(r) {
+                0 => {}
+                1 => {
+                    run.get_or_insert(k);
+                }
+                blocks => {
+                    flush(list, &mut run, k);
+                    list.push(SoftStage::Colour(pass, byte(k)), blocks);
+                }
+            }
         }
-        list.push(SoftStage::Overflow(pass), usize::from(self.overflow > 0));
+        let n = self.colours.len();
+        if self.overflow > 0 {
+            run.get_or_insert(n);
+            flush(list, &mut run, n + 1);
+        } else {
+            flush(list, &mut run, n);
+        }
     }
 }
 
@@ -153,7 +205,8 @@ struct Shared<'a> {
     cons: *mut ContactConstraint,
     n_cons: usize,
     overflow: Range<usize>,
-    rows: *mut JointScratch,
+    rows: JointView,
+    joint_colours: &'a [Range<usize>],
     joints: &'a JointSet,
 }
 
@@ -198,7 +251,8 @@ pub(crate) fn run(
         n_cons: scratch.cons.len(),
         cons: scratch.cons.as_mut_ptr(),
         overflow,
-        rows,
+        rows: JointView::new(rows),
+        joint_colours: &rows.colours,
         joints,
     };
     // SAFETY: see `Shared::exec`.
@@ -214,8 +268,9 @@ impl Shared<'_> {
     /// # Safety
     /// Only blocks of one stage run at the same time. Body blocks touch the bodies (and their
     /// terms and poses) of their own range of terms, and every body appears in one term;
-    /// colour blocks touch their own constraints and their dynamic bodies, disjoint within a
-    /// colour; joint and overflow stages are a single block.
+    /// contact and joint colour blocks touch their own constraints (joints: rows and blocks)
+    /// and their dynamic bodies, disjoint within a colour, and only read non-dynamic bodies
+    /// and the poses; serial stages are a single block.
     unsafe fn exec(&self, kind: SoftStage, block: usize, blocks: usize) {
         let c = &self.c;
         match kind {
@@ -238,21 +293,20 @@ impl Shared<'_> {
                     integrate::clamp_and_integrate_position(t, p, q, b, c.h);
                 }
             }
-            SoftStage::Joints(pass) => {
-                let rows = &mut *self.rows;
-                let bodies = std::slice::from_raw_parts_mut(self.bodies, self.n_bodies);
-                let (soft, inv_h) = (c.joint_soft, c.inv_h);
-                match pass {
-                    Pass::WarmStart => joints::warm_start(rows, bodies),
-                    Pass::Solve => joints::solve(rows, bodies, soft, inv_h, true),
-                    Pass::Relax => {
-                        // Joint rows follow the new poses (valid until the next position
-                        // update).
-                        joints::refresh(rows, self.joints, &*self.set, bodies);
-                        joints::solve(rows, bodies, soft, inv_h, false);
-                    }
-                    Pass::Restitution => {}
-                }
+            SoftStage::Joints(pass, k) => {
+                let pass = match pass {
+                    Pass::WarmStart => JointPass::WarmStart,
+                    Pass::Solve => JointPass::Solve,
+                    Pass::Relax => JointPass::Relax,
+                    Pass::Restitution => return,
+                };
+                let r = &self.joint_colours[k as usize];
+                let b = block_range(r.len(), blocks, block);
+                let range = r.start + b.start..r.start + b.end;
+                let (soft, inv_h, set) = (c.joint_soft, c.inv_h, &*self.set);
+                let (bodies, n) = (self.bodies, self.n_bodies);
+                self.rows
+                    .run(range, pass, bodies, n, set, self.joints, soft, inv_h);
             }
             SoftStage::Colour(pass, k) => {
                 let r = &self.colours[k as usize];
@@ -266,10 +320,22 @@ impl Shared<'_> {
                     self.scalar_pass(pass, range);
                 }
             }
-            SoftStage::Overflow(pass) => {
-                let range = self.overflow.clone();
-                assert!(range.end <= self.n_cons);
-                self.scalar_pass(pass, range);
+            SoftStage::Serial(pass, lo, hi) => {
+                for k in lo as usize..hi as usize {
+                    if let Some(r) = self.colours.get(k) {
+                        let items = if c.simd { self.n_wide } else { self.n_cons };
+                        assert!(r.end <= items);
+                        if c.simd {
+                            self.wide_pass(pass, r.clone());
+                        } else {
+                            self.scalar_pass(pass, r.clone());
+                        }
+                    } else {
+                        let range = self.overflow.clone();
+                        assert!(range.end <= self.n_cons);
+                        self.scalar_pass(pass, range);
+                    }
+                }
             }
         }
     }

@@ -11,8 +11,8 @@
 //!
 //! Everything from the first substep to the restitution pass is one list of stages (module
 //! `stages`, Box2D's `b2SolverStage`s) run in one parallel region: the body stages in blocks
-//! of bodies, each contact colour in blocks of constraints, the joints and the overflow
-//! colour as single blocks (module `soft_stages`).
+//! of bodies, each joint and contact colour in blocks of constraints, the overflow colours
+//! as single blocks (module `soft_stages`).
 
 use super::soft_stages::{self, Pass, SoftStage};
 use super::stages::thread_count;
@@ -74,7 +74,7 @@ pub(crate) fn step(ctx: &mut StepContext) {
     let shape = soft_stages::Shape {
         substeps: n,
         warm_starting: p.warm_starting,
-        joints: !rows.joints.is_empty(),
+        joint_colours: &rows.colours,
         colours,
         lanes: if simd { contact_simd::LANES } else { 1 },
         overflow,
@@ -99,14 +99,14 @@ pub(crate) fn step(ctx: &mut StepContext) {
         let slot = match kind {
             SoftStage::IntegrateVelocities => &mut ctx.timings.forces,
             SoftStage::IntegratePositions => &mut ctx.timings.integrate,
-            SoftStage::Joints(pass) | SoftStage::Colour(pass, _) | SoftStage::Overflow(pass) => {
-                match pass {
-                    Pass::WarmStart => &mut ctx.timings.warm_start,
-                    Pass::Solve => &mut ctx.timings.solve,
-                    Pass::Relax => &mut ctx.timings.relax,
-                    Pass::Restitution => &mut ctx.timings.restitution,
-                }
-            }
+            SoftStage::Joints(pass, _)
+            | SoftStage::Colour(pass, _)
+            | SoftStage::Serial(pass, _, _) => match pass {
+                Pass::WarmStart => &mut ctx.timings.warm_start,
+                Pass::Solve => &mut ctx.timings.solve,
+                Pass::Relax => &mut ctx.timings.relax,
+                Pass::Restitution => &mut ctx.timings.restitution,
+            },
         };
         *slot += d;
     }
