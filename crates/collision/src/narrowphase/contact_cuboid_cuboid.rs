@@ -130,9 +130,15 @@ fn clip_face_b(
     let id_base = ((fb as u32 & 0x3F) | 0x40) << 24;
     // Clipped in B's frame, each point mapped back to A's frame as it is appended (no
     // intermediate list).
-    clip_box_faces_with(hb, fb, ha, &pose_ab.inverse(), prediction, id_base, |c, id| {
-        out.push((c.swapped().transformed(pose_ab), id))
-    });
+    clip_box_faces_with(
+        hb,
+        fb,
+        ha,
+        &pose_ab.inverse(),
+        prediction,
+        id_base,
+        |c, id| out.push((c.swapped().transformed(pose_ab), id)),
+    );
 }
 
 /// Room for the corners of a box face through the four side-plane clips: a clip of a convex

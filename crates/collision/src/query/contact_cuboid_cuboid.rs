@@ -245,7 +245,11 @@ pub fn cuboid_cuboid_sat(
         'edges: for i in 0..3 {
             for j in 0..3 {
                 if let Some((overlap, dist, len)) = f.edge(i, j) {
-                    if !test((overlap, dist), &|| f.edge_axis(i, j, len), Axis::Edge(i, j)) {
+                    if !test(
+                        (overlap, dist),
+                        &|| f.edge_axis(i, j, len),
+                        Axis::Edge(i, j),
+                    ) {
                         overlapping = false;
                         break 'edges;
                     }
@@ -364,7 +368,11 @@ pub fn cuboid_cuboid_axis_or_separation(
         for j in 0..3 {
             // Parallel edges: the face axes decide.
             if let Some((overlap, dist, len)) = f.edge(i, j) {
-                consider((overlap, dist), &|| f.edge_axis(i, j, len), Axis::Edge(i, j))?;
+                consider(
+                    (overlap, dist),
+                    &|| f.edge_axis(i, j, len),
+                    Axis::Edge(i, j),
+                )?;
             }
         }
     }
