@@ -66,24 +66,23 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         for p in c.narrowphase().pairs() {
             let old = before.get(&(p.a, p.b));
             let m = &p.manifold;
-            let slot = if old.is_none() {
-                5
-            } else if !m.is_empty() {
-                let same = m.generated_at.is_some() && m.generated_at == old.unwrap().1;
-                if same {
-                    0
-                } else {
-                    1
+            let slot = match (old, m.apart) {
+                (None, _) => 5,
+                (Some(&(_, gen)), _) if !m.is_empty() => {
+                    if m.generated_at.is_some() && m.generated_at == gen {
+                        0
+                    } else {
+                        1
+                    }
                 }
-            } else if let Some(s) = m.apart {
-                let same = Some(s.pose_ab) == old.unwrap().0;
-                if same {
-                    2
-                } else {
-                    3
+                (Some(&(cert, _)), Some(s)) => {
+                    if Some(s.pose_ab) == cert {
+                        2
+                    } else {
+                        3
+                    }
                 }
-            } else {
-                4
+                (Some(_), None) => 4,
             };
             n[slot] += 1;
             if m.is_empty() {
