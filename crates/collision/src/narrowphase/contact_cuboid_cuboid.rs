@@ -26,7 +26,6 @@ use crate::query::contact_cuboid_cuboid::{
 };
 use crate::query::Contact;
 use crate::shape::{ConvexRef, Cuboid};
-use smallvec::SmallVec;
 
 /// Cosine under which a contact normal counts as a face normal when an edge axis is clipped
 /// as faces (about 2.6°, as the guided polyhedron path).
@@ -129,24 +128,52 @@ fn clip_face_b(
     out: &mut ContactList,
 ) {
     let id_base = ((fb as u32 & 0x3F) | 0x40) << 24;
-    let mut tmp: SmallVec<[(Contact, FeatureId); 16]> = SmallVec::new();
-    clip_box_faces(
+    // Clipped in B's frame, each point mapped back to A's frame as it is appended (no
+    // intermediate list).
+    clip_box_faces_with(
         hb,
         fb,
         ha,
         &pose_ab.inverse(),
         prediction,
         id_base,
-        &mut tmp,
-    );
-    out.extend(
-        tmp.into_iter()
-            .map(|(c, id)| (c.swapped().transformed(pose_ab), id)),
+        |c, id| out.push((c.swapped().transformed(pose_ab), id)),
     );
 }
 
-/// A polygon being clipped: points with feature ids.
-type Poly = SmallVec<[(Vec3, u32); 16]>;
+/// Room for the corners of a box face through the four side-plane clips: a clip of a convex
+/// polygon adds at most one corner, so a quad ends with at most 8. (A clip keeps every
+/// corner on or inside the plane and adds one per sign change along the polygon, so a
+/// polygon made non-convex by round-off could gain more; the clip then gives up and emits
+/// nothing, and the caller takes its fallback, as when the faces miss.)
+const CLIP_CAP: usize = 8;
+
+/// A polygon being clipped: corners (as arrays, so a runtime axis index is a plain index,
+/// not `Vec3`'s `match`) with feature ids, in a fixed buffer.
+#[derive(Clone, Copy)]
+struct Poly {
+    pts: [([Real; 3], u32); CLIP_CAP],
+    len: usize,
+}
+
+impl Poly {
+    const EMPTY: Poly = Poly {
+        pts: [([0.0; 3], 0); CLIP_CAP],
+        len: 0,
+    };
+
+    /// Appends a corner; false (nothing appended) when the buffer is full.
+    #[inline(always)]
+    #[must_use]
+    fn push(&mut self, p: [Real; 3], id: u32) -> bool {
+        if self.len == CLIP_CAP {
+            return false;
+        }
+        self.pts[self.len] = (p, id);
+        self.len += 1;
+        true
+    }
+}
 
 /// The face clipping of [`super::polyhedron`]'s `clip_faces` for two boxes: the incident
 /// box (half extents `hi`, at `pose_ri` in the reference box's frame) clips its face most
@@ -166,7 +193,27 @@ fn clip_box_faces(
     pose_ri: &Isometry,
     prediction: Real,
     id_base: u32,
-    out: &mut impl Extend<(Contact, FeatureId)>,
+    out: &mut ContactList,
+) {
+    clip_box_faces_with(hr, rf, hi, pose_ri, prediction, id_base, |c, id| {
+        out.push((c, id))
+    });
+}
+
+/// [`clip_box_faces`], handing each kept point to `emit` (in the reference frame). The
+/// polygon lives in two fixed buffers used in turn (it was a pair of 16-point `SmallVec`s
+/// swapped after each clip, and a `Vec3` indexed by a runtime axis: the copies and the
+/// index `match`es were half of the clip's instructions in "3000 fall"). The arithmetic is
+/// the same, operation for operation, so the points are the same bits.
+#[inline(always)]
+fn clip_box_faces_with(
+    hr: Vec3,
+    rf: usize,
+    hi: Vec3,
+    pose_ri: &Isometry,
+    prediction: Real,
+    id_base: u32,
+    mut emit: impl FnMut(Contact, FeatureId),
 ) {
     let i = rf / 2;
     let sign: Real = if rf.is_multiple_of(2) { 1.0 } else { -1.0 };
@@ -174,55 +221,69 @@ fn clip_box_faces(
     nr[i] = sign;
     let rot = pose_ri.rotation_matrix();
     let axes = [rot.x_axis, rot.y_axis, rot.z_axis];
+    let hi = hi.to_array();
+    let hr = hr.to_array();
     // The incident face: the incident axis most parallel to the normal, on the side facing
     // the reference face.
+    let col = |k: usize| axes[k].to_array()[i].abs();
     let mut j = 0;
     for k in 1..3 {
-        if axes[k][i].abs() > axes[j][i].abs() {
+        if col(k) > col(j) {
             j = k;
         }
     }
-    let facing_away = axes[j][i] * sign > 0.0;
+    let facing_away = axes[j].to_array()[i] * sign > 0.0;
     let inc_face = 2 * j + facing_away as usize;
     let m = if facing_away { -axes[j] } else { axes[j] };
     let centre = pose_ri.translation + m * hi[j];
     let (k1, k2) = ((j + 1) % 3, (j + 2) % 3);
     let (u, v) = (axes[k1] * hi[k1], axes[k2] * hi[k2]);
     let id = id_base | ((inc_face as u32 & 0xFF) << 16) | 0xFF;
-    let mut poly: Poly = [u + v, v - u, -u - v, u - v]
-        .iter()
-        .enumerate()
-        .map(|(k, &c)| (centre + c, id | ((k as u32 & 0xFF) << 8)))
-        .collect();
-    let mut tmp = Poly::new();
+    let mut bufs = [Poly::EMPTY; 2];
+    for (k, c) in [u + v, v - u, -u - v, u - v].into_iter().enumerate() {
+        let _ = bufs[0].push((centre + c).to_array(), id | ((k as u32 & 0xFF) << 8));
+    }
+    let mut cur = 0;
     let mut tag = 0;
     for k in [(i + 1) % 3, (i + 2) % 3] {
         for s in [1.0 as Real, -1.0] {
-            tmp.clear();
             let limit = hr[k];
-            for e in 0..poly.len() {
-                let (p, ip) = poly[e];
-                let (q, _) = poly[(e + 1) % poly.len()];
+            let (lo, hi_buf) = bufs.split_at_mut(1);
+            let (src, dst) = if cur == 0 {
+                (&lo[0], &mut hi_buf[0])
+            } else {
+                (&hi_buf[0], &mut lo[0])
+            };
+            dst.len = 0;
+            let n = src.len;
+            for e in 0..n {
+                let (p, ip) = src.pts[e];
+                let (q, _) = src.pts[if e + 1 == n { 0 } else { e + 1 }];
                 let (dp, dq) = (s * p[k] - limit, s * q[k] - limit);
-                if dp <= 0.0 {
-                    tmp.push((p, ip));
+                if dp <= 0.0 && !dst.push(p, ip) {
+                    return;
                 }
                 if (dp < 0.0) != (dq < 0.0) && dp != dq {
                     let t = dp / (dp - dq);
-                    tmp.push((p + (q - p) * t, (ip & 0xFFFF_FF00) | tag));
+                    let (pv, qv) = (Vec3::from_array(p), Vec3::from_array(q));
+                    if !dst.push((pv + (qv - pv) * t).to_array(), (ip & 0xFFFF_FF00) | tag) {
+                        return;
+                    }
                 }
             }
-            std::mem::swap(&mut poly, &mut tmp);
-            if poly.is_empty() {
+            cur ^= 1;
+            if bufs[cur].len == 0 {
                 return;
             }
             tag += 1;
         }
     }
-    out.extend(poly.into_iter().filter_map(|(p, fid)| {
+    let poly = &bufs[cur];
+    for &(p, fid) in &poly.pts[..poly.len] {
         let d = sign * p[i] - hr[i];
-        (d <= prediction).then(|| {
-            (
+        if d <= prediction {
+            let p = Vec3::from_array(p);
+            emit(
                 Contact {
                     distance: d,
                     point_a: p - nr * d,
@@ -230,9 +291,9 @@ fn clip_box_faces(
                     normal: nr,
                 },
                 fid,
-            )
-        })
-    }));
+            );
+        }
+    }
 }
 
 /// An edge–edge contact `c`: the faces when its normal is within about 2.6° of a face
