@@ -140,3 +140,76 @@ fn coherent_poses_reuse_points_and_moves_regenerate() {
     m.clear();
     assert!(m.generated_at.is_none());
 }
+
+/// Hulls touching within round-off (face-on, tilted and far from the origin), where EPA's
+/// polytope is degenerate and the guided path re-measures EPA's contact along its normal
+/// instead of running the full SAT: the manifold must still match the full SAT's.
+#[test]
+fn guided_manifold_on_touching_hulls_matches_the_full_sat() {
+    let mut rng = Rng::new(77);
+    let mut checked = 0;
+    for k in 0..120 {
+        let (ha, hb) = (random_hull(&mut rng, 24), random_hull(&mut rng, 24));
+        let fa = &ha.faces()[k % ha.faces().len()];
+        let fb = &hb.faces()[0];
+        // B's face against A's face, turned about the normal, tilted a little in one case
+        // out of three (edge or vertex touching), gap in [-1e-5, 1e-5].
+        let spin = Quat::from_axis_angle(fa.normal, rng.range(0.0, std::f32::consts::TAU as Real));
+        let tilt = if k % 3 == 0 {
+            Quat::from_axis_angle(rng.unit(), rng.range(0.0, 0.2))
+        } else {
+            Quat::IDENTITY
+        };
+        let rot = tilt * spin * Quat::from_rotation_arc(fb.normal, -fa.normal);
+        let lateral = rng.unit() * 0.3;
+        let lateral = lateral - fa.normal * fa.normal.dot(lateral);
+        let mut pose = Isometry::new(lateral, rot);
+        let lowest = hb
+            .vertices()
+            .iter()
+            .map(|v| fa.normal.dot(pose.transform_point(*v)))
+            .fold(Real::INFINITY, Real::min);
+        pose.translation += fa.normal * (fa.offset - lowest + rng.range(-1.0e-5, 1.0e-5));
+        if k % 4 == 1 {
+            // The same relative pose, built from world poses far from the origin.
+            let wa = Isometry::new(Vec3::new(1.0e3, -2.0e3, 5.0e2), Quat::IDENTITY);
+            let wb = wa * pose;
+            pose = wa.inverse() * wb;
+        }
+        let (pa, pb) = (Polyhedron::from_hull(&ha), Polyhedron::from_hull(&hb));
+        let sat = polyhedron_manifold(&pa, &pb, &pose, 0.01);
+        let mut guided: Vec<(Contact, u32)> = Vec::new();
+        polyhedron_manifold_guided(
+            &pa,
+            &pb,
+            ConvexRef::ConvexHull(&ha),
+            ConvexRef::ConvexHull(&hb),
+            &pose,
+            0.01,
+            &mut guided,
+        );
+        let min = |v: &[(Contact, u32)]| {
+            v.iter()
+                .map(|c| c.0.distance)
+                .fold(Real::INFINITY, Real::min)
+        };
+        assert_eq!(sat.is_empty(), guided.is_empty(), "case {k}");
+        if sat.is_empty() {
+            continue;
+        }
+        checked += 1;
+        assert!((min(&sat) - min(&guided)).abs() < 2.0e-4, "case {k}");
+        let n_sat = sat[0].0.normal;
+        for (c, _) in &guided {
+            assert!(c.distance.is_finite() && c.normal.is_finite());
+            assert!(c.normal.dot(n_sat) > 0.99, "case {k}: normal");
+            let slack = 1e-3 + c.distance.abs();
+            assert!(
+                inside(&ha, c.point_b, &Isometry::IDENTITY, slack),
+                "case {k}"
+            );
+            assert!(inside(&hb, c.point_a, &pose, slack), "case {k}");
+        }
+    }
+    assert!(checked > 100, "{checked}");
+}

@@ -69,6 +69,28 @@ pub fn contact_is_consistent(
         && (n.dot(c.point_b) - hb).abs() <= tol
 }
 
+/// `c` re-measured exactly along its own normal ([`contact_along`]) when that exact
+/// separation is within `slack` times the guard's tolerance of `c.distance` (a looser form of
+/// [`contact_is_consistent`] that drops the witnesses' check and replaces them); `None`
+/// otherwise. For polyhedra touching within round-off, where EPA's polytope is degenerate
+/// and its depth (not its normal) is slightly off.
+pub fn remeasured_near(
+    a: ConvexRef<'_>,
+    b: ConvexRef<'_>,
+    pose_ab: &Isometry,
+    c: &Contact,
+    slack: Real,
+) -> Option<Contact> {
+    let n = c.normal;
+    if !n.is_finite() || !c.distance.is_finite() || (n.length() - 1.0).abs() > 1.0e-3 {
+        return None;
+    }
+    let k = contact_along(a, b, pose_ab, n)?;
+    let ha = k.normal.dot(k.point_a);
+    let tol = tolerance(a, b, ha, ha + k.distance, c.distance);
+    ((k.distance - c.distance).abs() <= slack * tol).then_some(k)
+}
+
 /// The contact along direction `n`, measured exactly: distance `h_B(-n) - h_A(n)`, A's
 /// support point as `point_a`. `None` for a non-finite direction.
 fn contact_along(
