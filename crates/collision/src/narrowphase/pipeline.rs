@@ -91,7 +91,8 @@ pub struct ContactEvent<H> {
 /// Manifolds for every broadphase pair, keyed by object handles `H` (ordered pairs).
 ///
 /// The pairs live in one vector sorted by `(a, b)`, the pair order: a step removes and
-/// inserts the broadphase's changes in place (one compaction pass, one backward merge) and
+/// inserts the broadphase's changes in place (one merge walk, then whole runs of pairs moved
+/// by block swaps; runs that keep their place do not move) and
 /// updates the manifolds over the slice in parallel, so the steady state allocates nothing
 /// and the solver reads the manifolds contiguously. (A `BTreeMap` did the same with a node
 /// walk per pair and three vectors collected per step.)
@@ -107,6 +108,10 @@ pub struct NarrowPhase<H: Ord> {
     /// Indices of the pairs to remove, then the sorted pairs to add (reused buffers).
     dead: Vec<usize>,
     fresh: Vec<(H, H)>,
+    /// Runs of kept pairs to move (`start`, `end`, destination) and the slots of the new
+    /// pairs, in pair order (reused buffers of [`NarrowPhase::apply_changes`]).
+    runs: Vec<(usize, usize, usize)>,
+    slots: Vec<usize>,
     /// The dispatcher (algorithms and manifold configuration).
     pub dispatcher: Dispatcher,
 }
@@ -121,6 +126,8 @@ impl<H: Ord> Default for NarrowPhase<H> {
             was_touching: Vec::new(),
             dead: Vec::new(),
             fresh: Vec::new(),
+            runs: Vec::new(),
+            slots: Vec::new(),
             dispatcher: Dispatcher::default(),
         }
     }
@@ -134,6 +141,41 @@ fn new_pair<H>(a: H, b: H) -> PairContact<H> {
         touching: false,
         sensor: false,
         excluded: false,
+    }
+}
+
+/// Moves the run `v[s..e]` down to `v[d..]` (`d < s`) when `v[d..s]` holds only pairs to
+/// overwrite: whole blocks are swapped (at most `s - d` records each), so a run moves in a
+/// few block swaps rather than record by record, and the displaced records end in `v[..e]`'s
+/// tail. A shift by one rotates the run (one memmove).
+fn move_run_down<T>(v: &mut [T], mut s: usize, e: usize, mut d: usize) {
+    let gap = s - d;
+    if gap == 1 {
+        v[d..e].rotate_left(1);
+        return;
+    }
+    while s < e {
+        let c = gap.min(e - s);
+        let (lo, hi) = v.split_at_mut(s);
+        lo[d..d + c].swap_with_slice(&mut hi[..c]);
+        s += c;
+        d += c;
+    }
+}
+
+/// Moves the run `v[s..e]` up to start at `d` (`d > s`) when `v[e..d + e - s]` holds only
+/// pairs to overwrite (the mirror of [`move_run_down`]).
+fn move_run_up<T>(v: &mut [T], s: usize, mut e: usize, d: usize) {
+    let gap = d - s;
+    if gap == 1 {
+        v[s..e + 1].rotate_right(1);
+        return;
+    }
+    while e > s {
+        let c = gap.min(e - s);
+        let (lo, hi) = v.split_at_mut(e);
+        lo[e - c..].swap_with_slice(&mut hi[gap - c..gap]);
+        e -= c;
     }
 }
 
@@ -261,50 +303,82 @@ impl<H: Copy + Ord + Send + Sync> NarrowPhase<H> {
                 self.dead.push(i);
             }
         }
-        if !self.dead.is_empty() {
-            self.dead.sort_unstable();
-            self.dead.dedup();
-            let mut dead = self.dead.iter().copied().peekable();
-            let mut k = 0;
-            self.pairs.retain(|_| {
-                let drop = dead.next_if_eq(&k).is_some();
-                k += 1;
-                !drop
-            });
-        }
+        self.dead.sort_unstable();
+        self.dead.dedup();
+        let (pairs, dead) = (&mut self.pairs, &self.dead);
+        // A pair removed and added again in the same step is created afresh.
         self.fresh.clear();
         self.fresh.extend(added.iter().copied().filter(|&(a, b)| {
-            self.pairs
-                .binary_search_by(|p| (p.a, p.b).cmp(&(a, b)))
-                .is_err()
+            match pairs.binary_search_by(|p| (p.a, p.b).cmp(&(a, b))) {
+                Ok(i) => dead.binary_search(&i).is_ok(),
+                Err(_) => true,
+            }
         }));
-        if self.fresh.is_empty() {
+        if dead.is_empty() && self.fresh.is_empty() {
             return;
         }
         // Unique keys: an unstable sort is deterministic.
         self.fresh.sort_unstable();
         self.fresh.dedup();
-        // Backward merge: grow by the new pairs, then fill from the end.
-        let old = self.pairs.len();
-        let (a0, b0) = self.fresh[0];
-        self.pairs
-            .resize_with(old + self.fresh.len(), || new_pair(a0, b0));
-        let (mut i, mut j) = (old, self.fresh.len());
-        for w in (0..self.pairs.len()).rev() {
-            if j == 0 {
+        let fresh = &self.fresh;
+        // One merge walk: the runs of kept pairs between removals and insertions, with their
+        // destinations, and the slots of the new pairs.
+        let (runs, slots) = (&mut self.runs, &mut self.slots);
+        runs.clear();
+        slots.clear();
+        let n = pairs.len();
+        let pos = |j: usize| {
+            fresh
+                .get(j)
+                .map_or(n, |&k| pairs.partition_point(|p| (p.a, p.b) < k))
+        };
+        let (mut src, mut out, mut di, mut fj) = (0, 0, 0, 0);
+        let mut nf = pos(0);
+        loop {
+            let nd = dead.get(di).copied().unwrap_or(n);
+            let stop = nd.min(nf);
+            if stop > src {
+                if out != src {
+                    runs.push((src, stop, out));
+                }
+                out += stop - src;
+                src = stop;
+            }
+            if fj < fresh.len() && nf == src {
+                slots.push(out);
+                out += 1;
+                fj += 1;
+                nf = pos(fj);
+            } else if di < dead.len() && nd == src {
+                src += 1;
+                di += 1;
+            } else {
                 break;
             }
-            let (fa, fb) = self.fresh[j - 1];
-            if i > 0 && (self.pairs[i - 1].a, self.pairs[i - 1].b) > (fa, fb) {
-                self.pairs.swap(i - 1, w);
-                i -= 1;
-            } else {
-                let mut p = new_pair(fa, fb);
-                p.excluded = is_in(&self.excluded, fa, fb);
-                self.pairs[w] = p;
-                j -= 1;
-            }
         }
+        if out > n {
+            let (a0, b0) = fresh[0];
+            pairs.resize_with(out, || new_pair(a0, b0));
+        }
+        // Runs moving down go first, lowest first; runs moving up then, highest first: a
+        // run's destination then holds only removed pairs, vacated slots or new slots.
+        for &(s, e, d) in runs.iter().filter(|r| r.2 < r.0) {
+            move_run_down(pairs, s, e, d);
+        }
+        for &(s, e, d) in runs.iter().rev().filter(|r| r.2 > r.0) {
+            move_run_up(pairs, s, e, d);
+        }
+        for (&w, &(a, b)) in slots.iter().zip(fresh) {
+            // Reuses the removed pair's point buffer when there is one.
+            let p = &mut pairs[w];
+            p.a = a;
+            p.b = b;
+            p.manifold.clear();
+            p.touching = false;
+            p.sensor = false;
+            p.excluded = is_in(&self.excluded, a, b);
+        }
+        pairs.truncate(out);
     }
 
     /// One step: pairs `removed` are dropped and `added` created, then every manifold is
