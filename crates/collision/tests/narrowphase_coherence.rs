@@ -51,30 +51,17 @@ fn guided_manifold_agrees_with_the_full_sat() {
                 .fold(Real::INFINITY, Real::min);
             pose.translation = fa.normal * (fa.offset - lowest - 0.01);
         }
-        let (pa, pb) = (Polyhedron::from_hull(&ha), Polyhedron::from_hull(&hb));
-        let sat = polyhedron_manifold(&pa, &pb, &pose, 0.0);
-        let mut guided: Vec<(Contact, u32)> = Vec::new();
-        polyhedron_manifold_guided(
-            &pa,
-            &pb,
-            ConvexRef::ConvexHull(&ha),
-            ConvexRef::ConvexHull(&hb),
-            &pose,
-            0.0,
-            &mut guided,
-        );
-        let min = |v: &[(Contact, u32)]| {
-            v.iter()
-                .map(|c| c.0.distance)
-                .fold(Real::INFINITY, Real::min)
-        };
+        let (sat, guided) = full_sat_and_guided(&ha, &hb, &pose, 0.0);
         assert_eq!(sat.is_empty(), guided.is_empty(), "case {k}");
         if sat.is_empty() {
             continue;
         }
         checked += 1;
-        let tol = 2e-3 + 0.02 * min(&sat).abs();
-        assert!((min(&sat) - min(&guided)).abs() < tol, "case {k}");
+        let tol = 2e-3 + 0.02 * min_distance(&sat).abs();
+        assert!(
+            (min_distance(&sat) - min_distance(&guided)).abs() < tol,
+            "case {k}"
+        );
         for (c, _) in &guided {
             assert!(c.distance.is_finite() && c.normal.is_finite());
             let slack = 1e-3 + c.distance.abs();
@@ -176,29 +163,16 @@ fn guided_manifold_on_touching_hulls_matches_the_full_sat() {
             let wb = wa * pose;
             pose = wa.inverse() * wb;
         }
-        let (pa, pb) = (Polyhedron::from_hull(&ha), Polyhedron::from_hull(&hb));
-        let sat = polyhedron_manifold(&pa, &pb, &pose, 0.01);
-        let mut guided: Vec<(Contact, u32)> = Vec::new();
-        polyhedron_manifold_guided(
-            &pa,
-            &pb,
-            ConvexRef::ConvexHull(&ha),
-            ConvexRef::ConvexHull(&hb),
-            &pose,
-            0.01,
-            &mut guided,
-        );
-        let min = |v: &[(Contact, u32)]| {
-            v.iter()
-                .map(|c| c.0.distance)
-                .fold(Real::INFINITY, Real::min)
-        };
+        let (sat, guided) = full_sat_and_guided(&ha, &hb, &pose, 0.01);
         assert_eq!(sat.is_empty(), guided.is_empty(), "case {k}");
         if sat.is_empty() {
             continue;
         }
         checked += 1;
-        assert!((min(&sat) - min(&guided)).abs() < 2.0e-4, "case {k}");
+        assert!(
+            (min_distance(&sat) - min_distance(&guided)).abs() < 2.0e-4,
+            "case {k}"
+        );
         let n_sat = sat[0].0.normal;
         for (c, _) in &guided {
             assert!(c.distance.is_finite() && c.normal.is_finite());
@@ -212,4 +186,34 @@ fn guided_manifold_on_touching_hulls_matches_the_full_sat() {
         }
     }
     assert!(checked > 100, "{checked}");
+}
+
+/// The full-SAT manifold and the guided one (one GJK/EPA, then clipping) of two hulls at
+/// `pose` (B in A's frame), as (contact, feature id) lists.
+fn full_sat_and_guided(
+    ha: &ConvexHull,
+    hb: &ConvexHull,
+    pose: &Isometry,
+    prediction: Real,
+) -> (Vec<(Contact, u32)>, Vec<(Contact, u32)>) {
+    let (pa, pb) = (Polyhedron::from_hull(ha), Polyhedron::from_hull(hb));
+    let sat = polyhedron_manifold(&pa, &pb, pose, prediction);
+    let mut guided: Vec<(Contact, u32)> = Vec::new();
+    polyhedron_manifold_guided(
+        &pa,
+        &pb,
+        ConvexRef::ConvexHull(ha),
+        ConvexRef::ConvexHull(hb),
+        pose,
+        prediction,
+        &mut guided,
+    );
+    (sat.into_iter().collect(), guided)
+}
+
+/// The smallest signed distance of a manifold's points (infinity when empty).
+fn min_distance(v: &[(Contact, u32)]) -> Real {
+    v.iter()
+        .map(|c| c.0.distance)
+        .fold(Real::INFINITY, Real::min)
 }
