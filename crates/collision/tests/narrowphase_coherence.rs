@@ -188,6 +188,9 @@ fn guided_manifold_on_touching_hulls_matches_the_full_sat() {
     assert!(checked > 100, "{checked}");
 }
 
+/// A manifold's points with their feature ids.
+type Points = Vec<(Contact, u32)>;
+
 /// The full-SAT manifold and the guided one (one GJK/EPA, then clipping) of two hulls at
 /// `pose` (B in A's frame), as (contact, feature id) lists.
 fn full_sat_and_guided(
@@ -195,10 +198,10 @@ fn full_sat_and_guided(
     hb: &ConvexHull,
     pose: &Isometry,
     prediction: Real,
-) -> (Vec<(Contact, u32)>, Vec<(Contact, u32)>) {
+) -> (Points, Points) {
     let (pa, pb) = (Polyhedron::from_hull(ha), Polyhedron::from_hull(hb));
     let sat = polyhedron_manifold(&pa, &pb, pose, prediction);
-    let mut guided: Vec<(Contact, u32)> = Vec::new();
+    let mut guided: Points = Vec::new();
     polyhedron_manifold_guided(
         &pa,
         &pb,
