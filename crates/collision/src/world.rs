@@ -51,9 +51,11 @@ pub struct CollisionObject {
     pub pose: Isometry,
     /// Collision filter.
     pub filter: Filter,
-    /// World box at the last update (the shape's box expanded by `margin`).
+    /// World box at the last update (the shape's box expanded by `margin`, the linear part
+    /// of it only along `motion`; see [`CollisionObject::motion`]).
     pub aabb: Aabb,
-    /// Speculative margin (length): the box is expanded by it, and a pair generates contact
+    /// Speculative margin (length): the box is expanded by it (its `motion` part only along
+    /// the motion), and a pair generates contact
     /// points up to `max(prediction, margin_a + margin_b)` apart, less the part of the two
     /// margins that is linear motion when their motions are set (see
     /// [`CollisionObject::motion`]). A dynamics pipeline sets it from the object's motion over
@@ -63,7 +65,9 @@ pub struct CollisionObject {
     /// speculative contacts: a pair counts the *relative* displacement of its two objects,
     /// `margin_a - |motion_a| + margin_b - |motion_b| + |motion_a - motion_b|`, so bodies moving
     /// together (a falling column) get no speculative contacts from their common motion.
-    /// Zero by default ([`CollisionWorld::set_motion`]); it does not change the box.
+    /// Zero by default ([`CollisionWorld::set_motion`]). The box is grown by the margin's
+    /// own part `max(margin - |motion|, 0)` and swept along the motion (so with a zero
+    /// motion, by the whole margin).
     pub motion: Vec3,
     /// True when hinted resting ([`CollisionWorld::set_resting`]) or static: pairs of two
     /// such objects are not updated by the narrowphase.
@@ -106,6 +110,25 @@ fn check_pose_fast(pose: Isometry) -> Result<Isometry> {
     } else {
         check_isometry("pose", pose)
     }
+}
+
+/// The broadphase box of an object whose shape's box is `aabb`, for its speculative `margin`
+/// and linear `motion` (see [`CollisionObject::margin`]): the shape's box grown by the
+/// margin's own part `max(margin - |motion|, 0)` on every side, then swept along `motion`.
+///
+/// A pair's points are generated up to `own_a + own_b + |motion_a - motion_b|` apart, and two
+/// objects moving along their motions can only come that close during the step when these
+/// boxes overlap (each body's box over the step lies in its swept box), so the swept boxes
+/// find every pair that can meet. Growing the box by the whole margin on every side, as
+/// before, also paired bodies moving side by side or apart: on "3000 fall" 21.4 k pairs for
+/// 6.3 k manifolds. Rapier builds its broadphase boxes the same way (the box at the current
+/// pose merged with the box at the predicted pose, grown by the prediction distance);
+/// Bullet's `btDbvtBroadphase` sweeps its fat boxes along the displacement too.
+#[inline]
+fn speculative_box(aabb: Aabb, margin: Real, motion: Vec3) -> Aabb {
+    let own = (margin - motion.length()).max(0.0);
+    let m = Vec3::splat(own);
+    Aabb::new(aabb.min - m, aabb.max + m).swept(motion)
 }
 
 /// Objects plus a broadphase (see the module docs).
@@ -230,11 +253,21 @@ impl CollisionWorld {
 
     /// Sets the object's linear displacement over the coming step (see
     /// [`CollisionObject::motion`]; the margin should include its length). A non-finite
-    /// motion is an error.
+    /// motion is an error. The box follows the motion (it is swept along it), so a changed
+    /// motion recomputes the box at the next [`CollisionWorld::update`].
     pub fn set_motion(&mut self, h: ObjectHandle, motion: Vec3) -> Result<()> {
         let i = self.slot(h)?;
         let motion = crate::math::check_finite_vec("motion", motion)?;
-        self.objects[i].as_mut().expect("slot checked").motion = motion;
+        let o = self.objects[i].as_mut().expect("slot checked");
+        if o.motion != motion {
+            o.motion = motion;
+            if !o.dirty {
+                // The pose has not moved since the last box update.
+                o.displacement = Vec3::ZERO;
+                o.dirty = true;
+                self.dirty.push(i as u32);
+            }
+        }
         Ok(())
     }
 
@@ -259,9 +292,7 @@ impl CollisionWorld {
         let Some(o) = self.objects[i].as_mut() else {
             return Err(CaromError::UnknownHandle(format!("{h:?}")));
         };
-        let aabb = o.shape.aabb(&pose);
-        let m = Vec3::splat(margin);
-        let aabb = Aabb::new(aabb.min - m, aabb.max + m);
+        let aabb = speculative_box(o.shape.aabb(&pose), margin, motion);
         let displacement = pose.translation - o.pose.translation;
         // A pose far out can overflow the box or the displacement: checked before anything
         // changes, so the broadphase can take them unchecked (the handle is live: an object
@@ -347,10 +378,7 @@ impl CollisionWorld {
                 continue;
             }
             o.dirty = false;
-            o.aabb = o.shape.aabb(&o.pose);
-            if o.margin > 0.0 {
-                o.aabb = o.aabb.expanded(o.margin);
-            }
+            o.aabb = speculative_box(o.shape.aabb(&o.pose), o.margin, o.motion);
             self.broadphase
                 .update_proxy(o.handle.proxy(), o.aabb, o.displacement)?;
         }
