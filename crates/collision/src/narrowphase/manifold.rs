@@ -5,7 +5,7 @@
 //! as in Box3D's and Jolt's manifold reduction).
 
 use super::contact::{ContactPoint, NO_FEATURE};
-use crate::math::{Isometry, Real, Vec3};
+use crate::math::{Isometry, Mat3, Real, Vec3, Vec3A};
 use serde::{Deserialize, Serialize};
 
 /// Maximum number of points a manifold keeps after reduction.
@@ -191,28 +191,47 @@ impl ContactManifold {
         if self.points.is_empty() {
             return;
         }
-        // Rotation matrices once per manifold: three matrix–vector products per point are
-        // cheaper than three quaternion rotations.
-        let (ra, rb) = (pose_a.rotation_matrix(), pose_b.rotation_matrix());
-        let (ta, tb) = (pose_a.translation, pose_b.translation);
-        self.points.retain_mut(|p| {
-            let a = ra * p.local_a + ta;
-            let b = rb * p.local_b + tb;
-            let n = rb * p.local_normal_b;
+        // Rotation matrices once per manifold, as SIMD columns (`Vec3A`): three
+        // matrix–vector products per point, each three lane multiplies and two adds, summed
+        // in `Mat3 * Vec3`'s order (column by column, nothing fused), so every value has the
+        // scalar product's bits (the dot products too: `(x + y) + z` in both). In f64
+        // `Vec3A` is `Vec3` and this is the scalar code.
+        let cols = |q| {
+            let m = Mat3::from_quat(q);
+            [m.x_axis, m.y_axis, m.z_axis].map(Vec3A::from)
+        };
+        let (ra, rb) = (cols(pose_a.rotation), cols(pose_b.rotation));
+        let (ta, tb) = (
+            Vec3A::from(pose_a.translation),
+            Vec3A::from(pose_b.translation),
+        );
+        let mul = |m: &[Vec3A; 3], v: Vec3| m[0] * v.x + m[1] * v.y + m[2] * v.z;
+        let limit2 = breaking_threshold * breaking_threshold;
+        // In-place compaction, in order (what `retain_mut` did, without its per-point
+        // closure call).
+        let mut kept = 0;
+        for i in 0..self.points.len() {
+            let p = &self.points[i];
+            let a = mul(&ra, p.local_a) + ta;
+            let b = mul(&rb, p.local_b) + tb;
+            let n = mul(&rb, p.local_normal_b);
             let d = (a - b).dot(n);
             if d.is_nan() || d > breaking_threshold {
-                return false;
+                continue;
             }
             let drift = (a - n * d) - b;
-            if drift.length_squared() > breaking_threshold * breaking_threshold {
-                return false;
+            if drift.length_squared() > limit2 {
+                continue;
             }
+            let mut p = *p;
             p.distance = d;
-            p.normal = n;
-            p.point_b = b;
+            p.normal = n.into();
+            p.point_b = b.into();
             p.lifetime = p.lifetime.saturating_add(1);
-            true
-        });
+            self.points[kept] = p;
+            kept += 1;
+        }
+        self.points.truncate(kept);
     }
 
     /// The index of the cached point the new point `p` duplicates: the same feature id, or
