@@ -225,8 +225,8 @@ impl ContactManifold {
             }
             let mut p = *p;
             p.distance = d;
-            p.normal = n.into();
-            p.point_b = b.into();
+            p.normal = to_vec3(n);
+            p.point_b = to_vec3(b);
             p.lifetime = p.lifetime.saturating_add(1);
             self.points[kept] = p;
             kept += 1;
@@ -313,6 +313,13 @@ impl ContactManifold {
     pub fn reduce(&mut self) {
         reduce_points(&mut self.points);
     }
+}
+
+/// A SIMD vector back to [`Vec3`] (the identity in f64, where `Vec3A` is `Vec3`).
+#[inline(always)]
+#[allow(clippy::useless_conversion)]
+fn to_vec3(v: Vec3A) -> Vec3 {
+    v.into()
 }
 
 /// [`ContactManifold::reduce`] on a list of points, in place.
