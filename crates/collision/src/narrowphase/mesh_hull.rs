@@ -120,7 +120,9 @@ pub(crate) fn triangle_hull_manifold(
             }
         }
     }
-    let edge = triangle_hull_edge_query(a, b, posed, scratch);
+    // Only an edge pair separating more than both faces can change the manifold (see
+    // `triangle_hull_edge_query`), so the faces' best is the edge query's floor.
+    let edge = triangle_hull_edge_query(a, b, posed, sa.max(sb), scratch);
     if edge.0 > prediction {
         return;
     }
@@ -146,10 +148,22 @@ pub(crate) fn triangle_hull_manifold(
 /// hull edges that cross some triangle edge's circle are kept with a 3-bit mask, and each
 /// triangle edge then visits its own in hull-edge order, so the pairs are considered in
 /// the general path's order (ties resolve alike).
+///
+/// `floor` is the best face separation `max(sa, sb)`: the search starts from it (as if a
+/// pair at that separation had been found), so pairs that cannot beat it skip the hull
+/// edge's arc and the re-measure. Only an edge pair separating by more than both faces can
+/// be chosen by `manifold_from_sat` or raise its best separation, and the result is the
+/// unfloored search's whenever that exceeds `floor`: a re-measured separation never exceeds
+/// the pair's formula value (`min_B − max_A` along the axis is at most `pb·u − pa·u` for
+/// the edges' own points, in floating point too), so by induction the floored running best
+/// is the unfloored one raised to `floor`. Otherwise `(floor, 0, 0, 0)` is returned, which
+/// `manifold_from_sat` treats as the unfloored answer (a face is chosen either way, with
+/// the same best separation).
 fn triangle_hull_edge_query(
     a: &Polyhedron,
     b: &Polyhedron,
     posed: &PosedPolyhedron,
+    floor: Real,
     scratch: &mut EdgeScratch,
 ) -> (Real, usize, usize, Vec3) {
     let (vb, nb) = (&posed.vertices[..], &posed.normals[..]);
@@ -216,7 +230,7 @@ fn triangle_hull_edge_query(
     }
     let crossing = &crossing[..];
     let (edges_b, faces_b) = (b.edges(), b.edge_faces());
-    let mut best = (Real::NEG_INFINITY, 0, 0, Vec3::ZERO);
+    let mut best = (floor, 0, 0, Vec3::ZERO);
     for (i, ea) in a.edges().iter().enumerate() {
         let pa = va[ea[0] as usize];
         let (da, o) = (da[i], o[i]);
@@ -249,11 +263,24 @@ fn triangle_hull_edge_query(
                 continue;
             }
             let axis = axis / len;
+            let ua = axis.dot(o);
+            let sep = pb.dot(axis) - pa.dot(axis);
+            // The pair counts as `sep` (axis `u`, needs `ua >= 0`) or `-sep` (axis `-u`,
+            // needs `ua <= 0`) and only when that beats the best so far: decide that before
+            // building the hull edge's arc.
+            let reach = if ua > 0.0 {
+                sep
+            } else if ua < 0.0 {
+                -sep
+            } else {
+                sep.abs()
+            };
+            if !(reach > best.0) {
+                continue;
+            }
             let c = n0.cross(n1);
             let (g0, g1) = (c.cross(n0), n1.cross(c));
-            let ua = axis.dot(o);
             let (ub0, ub1) = (axis.dot(g0), axis.dot(g1));
-            let sep = pb.dot(axis) - pa.dot(axis);
             let fwd = (ua >= 0.0 && ub0 <= 0.0 && ub1 <= 0.0).then_some(sep);
             let bwd = (ua <= 0.0 && ub0 >= 0.0 && ub1 >= 0.0).then_some(-sep);
             let (s, ax) = match (fwd, bwd) {
