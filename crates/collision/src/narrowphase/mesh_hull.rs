@@ -88,6 +88,7 @@ const SPREAD: [u32; 16] = {
 pub(crate) struct EdgeScratch {
     blocks: SmallVec<[FaceBlock; 16]>,
     dots: [[Real; LANE_FACES]; 3],
+    odots: [[Real; LANE_FACES]; 3],
     signs: [u8; LANE_FACES],
     lists: [[u8; LANE_EDGES]; 3],
     dots_aos: SmallVec<[[Real; 3]; 64]>,
@@ -108,6 +109,7 @@ impl EdgeScratch {
         EdgeScratch {
             blocks: SmallVec::new(),
             dots: [[0.0; LANE_FACES]; 3],
+            odots: [[0.0; LANE_FACES]; 3],
             signs: [0; LANE_FACES],
             lists: [[0; LANE_EDGES]; 3],
             dots_aos: SmallVec::new(),
@@ -349,17 +351,21 @@ fn triangle_hull_edge_query(
         let EdgeScratch {
             blocks,
             dots,
+            odots,
             signs,
             lists,
             ..
         } = scratch;
         let d = da.map(|e| [W::splat(e.x), W::splat(e.y), W::splat(e.z)]);
+        let od = o.map(|e| [W::splat(e.x), W::splat(e.y), W::splat(e.z)]);
         let zero = W::splat(0.0);
         for (k, blk) in blocks.iter().enumerate() {
             let mut four = 0u32;
-            for (e, [dx, dy, dz]) in d.iter().enumerate() {
+            for (e, ([dx, dy, dz], [ox, oy, oz])) in d.iter().zip(&od).enumerate() {
                 let v = blk.x * *dx + blk.y * *dy + blk.z * *dz;
                 dots[e][4 * k..4 * k + 4].copy_from_slice(&v.to_array());
+                let w = blk.x * *ox + blk.y * *oy + blk.z * *oz;
+                odots[e][4 * k..4 * k + 4].copy_from_slice(&w.to_array());
                 let pos = v.simd_gt(zero).to_bitmask() as usize & 0xF;
                 let neg = v.simd_lt(zero).to_bitmask() as usize & 0xF;
                 four |= (SPREAD[pos] << e) | (SPREAD[neg] << (e + 3));
@@ -371,7 +377,10 @@ fn triangle_hull_edge_query(
         let mut counts = [0usize; 3];
         for (j, fb) in faces_b.iter().enumerate() {
             let both = signs[fb[0] as usize] & signs[fb[1] as usize];
-            let bits = !(both | (both >> 3));
+            let bits = !(both | (both >> 3)) & 0b111;
+            if bits == 0 {
+                continue;
+            }
             for (k, list) in lists.iter_mut().enumerate() {
                 list[counts[k]] = j as u8;
                 counts[k] += usize::from((bits >> k) & 1 != 0);
@@ -379,12 +388,26 @@ fn triangle_hull_edge_query(
         }
         for (i, ea) in a.edges().iter().enumerate() {
             let edge = TriEdge::new(va[ea[0] as usize], da[i], o[i]);
-            let row = &dots[i];
+            let (row, orow) = (&dots[i], &odots[i]);
+            let bound = PREFILTER_SIN * PREFILTER_SIN * edge.oo;
             for &j in &lists[i][..counts[i]] {
                 let j = j as usize;
                 let fb = faces_b[j];
-                let (a0, a1) = (row[fb[0] as usize], row[fb[1] as usize]);
-                pair_test(&pair, &edge, i, j, a0, a1, &mut best);
+                let (f0, f1) = (fb[0] as usize, fb[1] as usize);
+                let (a0, a1) = (row[f0], row[f1]);
+                // The prefilter with `m · o = a0 (n1 · o) - a1 (n0 · o)` from the faces'
+                // dots with `o`, and `|m|² <= (|a0| + |a1|)²` (unit normals): it drops no
+                // pair the exact prefilter keeps (up to round-off, far inside its margin).
+                let mo = if a0 > 0.0 {
+                    a0 * orow[f1] - a1 * orow[f0]
+                } else {
+                    a1 * orow[f0] - a0 * orow[f1]
+                };
+                let mm = a0.abs() + a1.abs();
+                if mo > 0.0 && mo * mo > bound * mm * mm {
+                    continue;
+                }
+                pair_exact(&pair, &edge, i, j, &mut best);
             }
         }
         return best;
@@ -460,8 +483,7 @@ impl TriEdge {
 
 /// Triangle edge `i` (`e`) against hull edge `j`, whose face normals have dots `a0`, `a1`
 /// with the triangle edge's direction and lie on both sides of its great circle: the
-/// crossing-point prefilter, then the general path's exact test, updating `best` when the
-/// pair separates more than it.
+/// crossing-point prefilter, then [`pair_exact`].
 #[inline(always)]
 fn pair_test(
     p: &PairInputs<'_>,
@@ -472,9 +494,8 @@ fn pair_test(
     a1: Real,
     best: &mut (Real, usize, usize, Vec3),
 ) {
-    let (eb, fb) = (p.edges_b[j], p.faces_b[j]);
+    let fb = p.faces_b[j];
     let (n0, n1) = (p.nb[fb[0] as usize], p.nb[fb[1] as usize]);
-    let (pa, da, o) = (e.pa, e.da, e.o);
     // The arc's crossing point `m`; the pair's axis is `-m`, which must not lie clearly
     // beyond the triangle edge's half circle (`m · o > 0`).
     let m = if a0 > 0.0 {
@@ -482,10 +503,25 @@ fn pair_test(
     } else {
         n0 * a1 - n1 * a0
     };
-    let mo = m.dot(o);
+    let mo = m.dot(e.o);
     if mo > 0.0 && mo * mo > PREFILTER_SIN * PREFILTER_SIN * m.length_squared() * e.oo {
         return;
     }
+    pair_exact(p, e, i, j, best);
+}
+
+/// The general path's exact test of triangle edge `i` (`e`) against hull edge `j`,
+/// updating `best` when the pair separates more than it.
+#[inline(always)]
+fn pair_exact(
+    p: &PairInputs<'_>,
+    e: &TriEdge,
+    i: usize,
+    j: usize,
+    best: &mut (Real, usize, usize, Vec3),
+) {
+    let (eb, fb) = (p.edges_b[j], p.faces_b[j]);
+    let (pa, da, o) = (e.pa, e.da, e.o);
     // The exact test of the general path.
     let (pb, qb) = (p.vb[eb[0] as usize], p.vb[eb[1] as usize]);
     let db = qb - pb;
@@ -510,6 +546,7 @@ fn pair_test(
     if !(reach > best.0) {
         return;
     }
+    let (n0, n1) = (p.nb[fb[0] as usize], p.nb[fb[1] as usize]);
     let c = n0.cross(n1);
     let (g0, g1) = (c.cross(n0), n1.cross(c));
     let (ub0, ub1) = (axis.dot(g0), axis.dot(g1));
