@@ -543,7 +543,8 @@ fn pair_exact(
     } else {
         sep.abs()
     };
-    if !(reach > best.0) {
+    let beats = reach > best.0; // false for NaN
+    if !beats {
         return;
     }
     let (n0, n1) = (p.nb[fb[0] as usize], p.nb[fb[1] as usize]);
