@@ -96,18 +96,25 @@ impl Quantization {
 
     /// Quantised coordinates of `p` rounded down (`up = false`) or up, with one unit of
     /// margin for rounding, clamped to `u16`.
+    ///
+    /// The value is clamped to `[0, 65535]` first and then rounded by truncation (a
+    /// non-negative value's floor; its ceiling adds one when the truncation is below it):
+    /// the same integer as rounding then clamping (both bounds are integers and rounding is
+    /// monotone; NaN gives 0 either way), without the `floor`/`ceil` library calls that the
+    /// baseline x86-64 target makes (a third of a mesh box query's instructions).
     #[inline]
     pub fn quantize(&self, p: Vec3, up: bool) -> [u16; 3] {
         let x = (p - self.origin) * self.scale;
         let mut out = [0u16; 3];
         for i in 0..3 {
             let slack = 1.0 + x[i].abs() * 4.0 * EPSILON;
-            let v = if up {
-                (x[i] + slack).ceil()
+            out[i] = if up {
+                let c = (x[i] + slack).clamp(0.0, 65535.0);
+                let t = c as u16;
+                t + u16::from((t as Real) < c)
             } else {
-                (x[i] - slack).floor()
+                (x[i] - slack).clamp(0.0, 65535.0) as u16
             };
-            out[i] = v.clamp(0.0, 65535.0) as u16;
         }
         out
     }
@@ -573,6 +580,89 @@ mod tests {
     #[test]
     fn node_sizes() {
         assert_eq!(std::mem::size_of::<QuantizedNode>(), 16);
+    }
+
+    /// The rounding `quantize` replaced: `floor`/`ceil`, then the clamp.
+    fn quantize_by_floor_ceil(q: &Quantization, p: Vec3, up: bool) -> [u16; 3] {
+        let x = (p - q.origin) * q.scale;
+        [0, 1, 2].map(|i| {
+            let slack = 1.0 + x[i].abs() * 4.0 * EPSILON;
+            let v = if up {
+                (x[i] + slack).ceil()
+            } else {
+                (x[i] - slack).floor()
+            };
+            v.clamp(0.0, 65535.0) as u16
+        })
+    }
+
+    #[test]
+    fn quantize_rounds_like_floor_and_ceil() {
+        // Unit scale and origin 0: the quantised coordinate is the point itself (plus or
+        // minus the one-unit slack), so integers, half-integers, the clamp bounds, points
+        // outside them, NaN and infinities are all hit exactly.
+        let unit = Quantization {
+            origin: Vec3::ZERO,
+            scale: Vec3::ONE,
+            inv_scale: Vec3::ONE,
+            dequantize_pad: Vec3::ZERO,
+        };
+        let far = Quantization::new(&Aabb::new(
+            Vec3::new(1.0e3, -250.0, -0.5),
+            Vec3::new(1.0e3 + 500.0, 37.0, 0.5),
+        ));
+        let mut values: Vec<Real> = vec![
+            0.0,
+            -0.0,
+            0.5,
+            1.0,
+            1.5,
+            2.0,
+            -0.5,
+            -1.0,
+            -1.5,
+            -2.0,
+            65533.0,
+            65534.0,
+            65534.5,
+            65535.0,
+            65536.0,
+            65536.5,
+            65537.0,
+            1.0e9,
+            -1.0e9,
+            Real::NAN,
+            Real::INFINITY,
+            Real::NEG_INFINITY,
+            Real::EPSILON,
+            1.0 - Real::EPSILON,
+            1.0 + Real::EPSILON,
+        ];
+        let mut seed = 0x2545_f491_u32;
+        for _ in 0..20_000 {
+            seed ^= seed << 13;
+            seed ^= seed >> 17;
+            seed ^= seed << 5;
+            values.push((seed as Real / u32::MAX as Real) * 70_000.0 - 2_000.0);
+        }
+        for q in [&unit, &far] {
+            for (k, &v) in values.iter().enumerate() {
+                let w = values[(k * 7 + 3) % values.len()];
+                let p = if std::ptr::eq(q, &far) {
+                    // Spread over (and beyond) the far box: world units.
+                    Vec3::new(1.0e3 + v * 0.01, v * 0.004 - 250.0, w * 1.0e-5)
+                } else {
+                    Vec3::new(v, w, -v)
+                };
+                for up in [false, true] {
+                    assert_eq!(
+                        q.quantize(p, up),
+                        quantize_by_floor_ceil(q, p, up),
+                        "{p:?} up {up}"
+                    );
+                }
+            }
+        }
     }
 
     #[test]

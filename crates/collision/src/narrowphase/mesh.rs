@@ -11,7 +11,9 @@
 //! it may turn up to the dihedral angle.
 
 use super::contact::{ContactList, FeatureId};
-use super::mesh_hull::{posed_hull, triangle_hull_manifold, EdgeScratch};
+#[cfg(test)]
+use super::mesh_hull::{posed_hull, EdgeScratch};
+use super::mesh_hull::{triangle_hull_manifold, PlacedHull};
 use super::polyhedron::Polyhedron;
 use crate::math::Aabb;
 use crate::math::{Isometry, Real, Vec3};
@@ -21,6 +23,7 @@ use crate::shape::{
     ConvexHull, ConvexRef, EdgeKind, HeightField, MeshEdge, SupportMap, TriMesh, Triangle,
 };
 use smallvec::SmallVec;
+use std::cell::RefCell;
 
 /// A triangle soup with a midphase and precomputed (or derivable) edge convexity: what
 /// convex-vs-triangles contact generation needs. Implemented by [`TriMesh`] (BVH, edges
@@ -302,8 +305,8 @@ fn contacts_in_box<M: ContactTriangles + ?Sized>(
 
 /// Triangles A against convex hull B: [`mesh_convex_contacts`] with the triangle–hull
 /// separating-axis test of [`super::mesh_hull`], the hull placed in the mesh's frame once
-/// (vertices, face planes; [`posed_hull`]) for all the triangles instead of once per
-/// triangle. Given the same placed hull the contacts are those of the per-triangle
+/// (vertices, face planes, in a per-thread `PlacedHull` refilled in place) for all the
+/// triangles instead of once per triangle. Given the same placed hull the contacts are those of the per-triangle
 /// `convex_convex` path bit for bit; the placement by a rotation matrix rounds differently
 /// from the quaternion's, by a few ulps.
 ///
@@ -327,24 +330,39 @@ pub fn mesh_hull_contacts<M: ContactTriangles + ?Sized>(
     let (lo, hi) = (lo + pose_ab.translation, hi + pose_ab.translation);
     let aabb = Aabb::new(lo, hi).expanded(prediction.max(0.0));
     let slab = PlaneSlab::from_box(lo, hi);
-    let mut scratch = EdgeScratch::default();
-    let mut posed = None;
-    let mut tri_contacts = |t: &Triangle, out: &mut ContactList| {
-        let posed = posed.get_or_insert_with(|| posed_hull(&pb, pose_ab));
-        let pa = Polyhedron::from_triangle(t);
-        triangle_hull_manifold(&pa, &pb, posed, pose_ab, prediction, &mut scratch, out);
-    };
-    let b = ConvexRef::ConvexHull(hull);
-    contacts_in_box(
-        mesh,
-        b,
-        pose_ab,
-        prediction,
-        &aabb,
-        Some(slab),
-        &mut tri_contacts,
-        out,
-    );
+    thread_local! {
+        static PLACED: RefCell<PlacedHull> = RefCell::new(PlacedHull::new());
+    }
+    PLACED.with(|cell| {
+        // A re-entrant call (none in the library) gets a fresh placement.
+        let mut fresh = None;
+        let mut guard = cell.try_borrow_mut();
+        let placed = match guard.as_deref_mut() {
+            Ok(p) => p,
+            Err(_) => fresh.insert(PlacedHull::new()),
+        };
+        let mut is_placed = false;
+        let mut tri_contacts = |t: &Triangle, out: &mut ContactList| {
+            if !is_placed {
+                placed.place(&pb, pose_ab);
+                is_placed = true;
+            }
+            let pa = Polyhedron::from_triangle(t);
+            let PlacedHull { posed, scratch } = &mut *placed;
+            triangle_hull_manifold(&pa, &pb, posed, pose_ab, prediction, scratch, out);
+        };
+        let b = ConvexRef::ConvexHull(hull);
+        contacts_in_box(
+            mesh,
+            b,
+            pose_ab,
+            prediction,
+            &aabb,
+            Some(slab),
+            &mut tri_contacts,
+            out,
+        );
+    });
 }
 
 #[cfg(test)]

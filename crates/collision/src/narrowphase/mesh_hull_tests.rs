@@ -74,7 +74,7 @@ fn compare(tri: &Triangle, hull: &ConvexHull, pose: &Isometry, prediction: Real)
     polyhedron_manifold_posed(&pa, &pb, &general, pose, prediction, &mut old);
     let posed = PosedPolyhedron::new(&pb, pose, false);
     let mut new = Vec::new();
-    let mut scratch = EdgeScratch::default();
+    let mut scratch = EdgeScratch::new(&pb, &posed);
     triangle_hull_manifold(&pa, &pb, &posed, pose, prediction, &mut scratch, &mut new);
     assert_eq!(bits(&old), bits(&new), "triangle {tri:?} pose {pose:?}");
     let edge = new.iter().any(|(_, id)| id & 0x8000_0000 != 0);

@@ -139,7 +139,7 @@ fn hull_box_cull_only_skips_triangles_beyond_the_prediction() {
             let pb = Polyhedron::from_hull(&hull);
             let posed = super::posed_hull(&pb, &pose);
             let mut out = ContactList::new();
-            let mut scratch = super::EdgeScratch::default();
+            let mut scratch = super::EdgeScratch::new(&pb, &posed);
             let pa = Polyhedron::from_triangle(&tri);
             super::triangle_hull_manifold(
                 &pa,
