@@ -486,8 +486,8 @@ impl Linear {
     /// Records impulse change `lambda` along direction `k` (0: normal, 1, 2: tangents).
     #[inline(always)]
     fn push(&mut self, k: usize, lambda: W) {
-        self.u[k] = self.u[k] + lambda * self.inv_m;
-        self.total[k] = self.total[k] + lambda;
+        self.u[k] += lambda * self.inv_m;
+        self.total[k] += lambda;
     }
 
     /// Applies the summed linear impulse to both bodies.
