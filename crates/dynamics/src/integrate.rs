@@ -109,7 +109,7 @@ pub(crate) fn prepare_terms(
             t.flags |= DYNAMIC;
             t.dv = (gravity * info.gravity_scale + set.force[i] * b.inv_m) * h;
             t.dw = b.inv_i * (set.torque[i] * h);
-            if gyroscopic {
+            if gyroscopic && !is_isotropic(&info.inv_inertia_local) {
                 t.flags |= GYROSCOPIC;
                 // Until `INERTIA` is set: the local inverse inertia.
                 t.inertia = info.inv_inertia_local;
@@ -125,6 +125,24 @@ pub(crate) fn prepare_terms(
         }
         out.push(t);
     }
+}
+
+/// Whether a local inverse inertia is a multiple of the identity (cubes, spheres, regular
+/// solids). The gyroscopic torque `ω × I ω` of such a body is zero for every `ω`, and the
+/// implicit step [`gyroscopic_implicit`] (whose residual `h ω × I ω` is then zero in exact
+/// arithmetic) returns `ω` unchanged, so [`prepare_terms`] skips it: its ~300 instructions
+/// per body and substep only added round-off ("1000 stack": 7 % of the solver's
+/// instructions). Exact comparisons: a nearly isotropic body keeps the term.
+fn is_isotropic(m: &Mat3) -> bool {
+    let d = m.x_axis.x;
+    m.y_axis.y == d
+        && m.z_axis.z == d
+        && m.x_axis.y == 0.0
+        && m.x_axis.z == 0.0
+        && m.y_axis.x == 0.0
+        && m.y_axis.z == 0.0
+        && m.z_axis.x == 0.0
+        && m.z_axis.y == 0.0
 }
 
 /// Velocity update over `h` for awake dynamic bodies: gravity and forces, torques, the
@@ -410,5 +428,67 @@ mod tests {
             "{l1} vs {l0}"
         );
         close(bodies[k].dp.z, -1.5 * t);
+    }
+
+    /// The isotropic skip against the slow path: for inverse inertias that are multiples of
+    /// the identity (tiny to huge, and zero), the full implicit step returns `ω` to
+    /// round-off for every rotation and `ω` (random, axis-aligned, zero, fast spins up to
+    /// 4 rad per step; `h` of 1/240 to 1 s), so skipping it changes nothing but round-off; and bodies that are not
+    /// isotropic (a brick, a cube with a rounding-size off-diagonal, a slightly unequal
+    /// diagonal) keep the term.
+    #[test]
+    fn isotropic_bodies_skip_an_identity_gyroscopic_step() {
+        let mut seed = 0x9e37_79b9_7f4a_7c15_u64;
+        let mut next = || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as Real / (1u64 << 53) as Real * 2.0 - 1.0
+        };
+        for scale in [0.0, 1e-6, 1.0 / 6.0, 1.0, 1e6] {
+            let inv = Mat3::from_diagonal(Vec3::splat(scale));
+            assert!(is_isotropic(&inv));
+            if scale == 0.0 {
+                continue; // no inertia to invert: `has_inertia` refuses it as well
+            }
+            let inertia = inv.inverse();
+            for k in 0..200 {
+                let q = Quat::from_xyzw(next(), next(), next(), next()).normalize();
+                let w = match k {
+                    0 => Vec3::ZERO,
+                    1 => Vec3::X * 50.0,
+                    2 => Vec3::new(0.0, -1e-7, 0.0),
+                    _ => Vec3::new(next(), next(), next()) * (10.0 as Real).powi(k % 5 - 1),
+                };
+                for h in [1.0 / 240.0, 1.0 / 60.0, 1.0] {
+                    if h * w.length() > 4.0 {
+                        continue; // beyond any speed limit: the slow path's own round-off
+                    }
+                    let full = gyroscopic_implicit(q, inertia, w, h);
+                    let tol = 1e-5 * w.length() + Real::MIN_POSITIVE;
+                    assert!((full - w).length() <= tol, "{full} vs {w}");
+                }
+            }
+        }
+        let brick = Mat3::from_diagonal(Vec3::new(1.0, 2.0, 3.0));
+        let mut skewed = Mat3::IDENTITY;
+        skewed.x_axis.y = 1e-7;
+        let unequal = Mat3::from_diagonal(Vec3::new(1.0, 1.0, 1.0 + 1e-6));
+        for m in [brick, skewed, unequal] {
+            assert!(!is_isotropic(&m), "{m}");
+        }
+        // `prepare_terms` sets the gyroscopic flag for the brick only.
+        let mut set = BodySet::new();
+        set.insert(&BodyDesc::dynamic(cube(), Isometry::IDENTITY, 1000.0))
+            .unwrap();
+        let brick: Arc<Shape> = Arc::new(Cuboid::new(Vec3::new(0.5, 1.0, 1.5)).unwrap().into());
+        set.insert(&BodyDesc::dynamic(brick, Isometry::IDENTITY, 1000.0))
+            .unwrap();
+        let mut bodies = Vec::new();
+        load(&set, &mut bodies);
+        let mut terms = Vec::new();
+        prepare_terms(&set, &bodies, Vec3::ZERO, 0.01, true, &mut terms);
+        let flags: Vec<bool> = terms.iter().map(|t| t.flags & GYROSCOPIC != 0).collect();
+        assert_eq!(flags, [false, true]);
     }
 }

@@ -440,10 +440,77 @@ pub(crate) fn solve_push_si(
     }
 }
 
+/// The linear velocities of a constraint's two bodies during [`solve_soft`], tracked in
+/// the constraint's orthonormal frame `(n, t₀, t₁)` instead of in the bodies.
+///
+/// Every row of a constraint has the linear part `±d` for one of the three directions, the
+/// same for all its points; only the angular parts differ from point to point. An impulse
+/// `λ` along `d` changes `v_b − v_a` by `λ (m_a⁻¹ + m_b⁻¹) d`, hence `d · (v_b − v_a)` by
+/// `λ (m_a⁻¹ + m_b⁻¹)` and the projections on the two other directions not at all. So the
+/// solve projects `v_b − v_a` on the frame once, updates one projection per row by a
+/// multiply-add, sums the impulses per direction, and applies the linear impulse
+/// `Σλ_n n + Σλ₀ t₀ + Σλ₁ t₁` to both bodies once at the end: the velocities of applying
+/// every row to the bodies (Box2D v3, Rapier) in exact arithmetic, to round-off in floating
+/// point (the frame is orthonormal to round-off; `contact_simd_tests.rs` checks it against
+/// the row-by-row solve, [`solve_soft_rows`]). The four-wide solve (module `contact_simd`) does the same, operation for
+/// operation.
+pub(crate) struct FrameVelocity {
+    /// `n · (v_b − v_a)`, `t₀ · (v_b − v_a)`, `t₁ · (v_b − v_a)`.
+    u: [Real; 3],
+    /// Sums of the impulse changes along `n`, `t₀`, `t₁`.
+    total: [Real; 3],
+    /// `m_a⁻¹ + m_b⁻¹`.
+    inv_m: Real,
+}
+
+impl FrameVelocity {
+    #[inline(always)]
+    fn new(c: &ContactConstraint, a: &SolverBody, b: &SolverBody) -> FrameVelocity {
+        let dv = b.v - a.v;
+        FrameVelocity {
+            u: [c.normal.dot(dv), c.tangent[0].dot(dv), c.tangent[1].dot(dv)],
+            total: [0.0; 3],
+            inv_m: a.inv_m + b.inv_m,
+        }
+    }
+
+    /// Records the impulse change `lambda` along direction `k` (0 normal, 1 and 2 tangents).
+    #[inline(always)]
+    fn push(&mut self, k: usize, lambda: Real) {
+        self.u[k] += lambda * self.inv_m;
+        self.total[k] += lambda;
+    }
+
+    /// Applies the summed linear impulse to both bodies.
+    #[inline(always)]
+    fn finish(&self, c: &ContactConstraint, a: &mut SolverBody, b: &mut SolverBody) {
+        let imp =
+            c.normal * self.total[0] + c.tangent[0] * self.total[1] + c.tangent[1] * self.total[2];
+        a.v -= imp * a.inv_m;
+        b.v += imp * b.inv_m;
+    }
+}
+
+impl ContactRow {
+    /// [`ContactRow::velocity`] given its linear part `u`.
+    #[inline(always)]
+    fn velocity_from(&self, u: Real, a: &SolverBody, b: &SolverBody) -> Real {
+        u + self.ang_b.dot(b.w) - self.ang_a.dot(a.w)
+    }
+
+    /// The angular half of [`ContactRow::apply`].
+    #[inline(always)]
+    fn apply_angular(&self, lambda: Real, a: &mut SolverBody, b: &mut SolverBody) {
+        a.w -= self.inv_ang_a * lambda;
+        b.w += self.inv_ang_b * lambda;
+    }
+}
+
 /// Soft step: friction, then the normal rows (Box2D v3's `b2SolveContact`, with Box2D v2.4's
 /// friction-first order, which creeps less in the pyramid test). The separation is
 /// updated from the position deltas of the substeps; with `use_bias` penetration is pushed
 /// out softly (capped at `max_push`), without it (relax) the rows are rigid and bias-free.
+/// The linear velocities follow the constraint frame ([`FrameVelocity`]).
 pub(crate) fn solve_soft(
     c: &mut ContactConstraint,
     a: &mut SolverBody,
@@ -452,23 +519,84 @@ pub(crate) fn solve_soft(
     max_push: Real,
     use_bias: bool,
 ) {
-    solve_friction(c, a, b);
-    let linear = c.normal.dot(b.dp - a.dp);
+    let mut lin = FrameVelocity::new(c, a, b);
+    for p in c.points[..c.len].iter_mut() {
+        let [r0, r1] = &p.tangent_rows;
+        let old = p.tangent_impulse;
+        let mut new = [
+            old[0] - r0.mass * r0.velocity_from(lin.u[1], a, b),
+            old[1] - r1.mass * r1.velocity_from(lin.u[2], a, b),
+        ];
+        let max = c.friction * p.normal_impulse;
+        let len_sq = new[0] * new[0] + new[1] * new[1];
+        if len_sq > max * max {
+            let s = max / len_sq.sqrt();
+            new = [new[0] * s, new[1] * s];
+        }
+        p.tangent_impulse = new;
+        let (d0, d1) = (new[0] - old[0], new[1] - old[1]);
+        r0.apply_angular(d0, a, b);
+        lin.push(1, d0);
+        r1.apply_angular(d1, a, b);
+        lin.push(2, d1);
+    }
+    let (linear, soft) = (c.normal.dot(b.dp - a.dp), c.softness);
     for p in c.points[..c.len].iter_mut() {
         let row = &p.normal_row;
         let s = p.separation + row.displacement(linear, a, b);
-        let (bias, mass_scale, impulse_scale) = if s > 0.0 {
-            (s * inv_h, 1.0, 0.0)
-        } else if use_bias {
-            let soft = c.softness;
-            (
-                (soft.bias_rate * s).max(-max_push),
-                soft.mass_scale,
-                soft.impulse_scale,
-            )
-        } else {
-            (0.0, 1.0, 0.0)
-        };
+        let (bias, mass_scale, impulse_scale) = soft_terms(soft, s, inv_h, max_push, use_bias);
+        let vn = row.velocity_from(lin.u[0], a, b);
+        let lambda = -row.mass * mass_scale * (vn + bias) - impulse_scale * p.normal_impulse;
+        let new = (p.normal_impulse + lambda).max(0.0);
+        let d = new - p.normal_impulse;
+        row.apply_angular(d, a, b);
+        lin.push(0, d);
+        p.normal_impulse = new;
+        p.max_normal_impulse = p.max_normal_impulse.max(new);
+    }
+    lin.finish(c, a, b);
+}
+
+/// Bias, mass scale and impulse scale of a normal row at separation `s`: speculative (the
+/// gap may close within the substep), soft (penetration with `use_bias`), or rigid.
+#[inline(always)]
+fn soft_terms(
+    soft: Softness,
+    s: Real,
+    inv_h: Real,
+    max_push: Real,
+    use_bias: bool,
+) -> (Real, Real, Real) {
+    if s > 0.0 {
+        (s * inv_h, 1.0, 0.0)
+    } else if use_bias {
+        (
+            (soft.bias_rate * s).max(-max_push),
+            soft.mass_scale,
+            soft.impulse_scale,
+        )
+    } else {
+        (0.0, 1.0, 0.0)
+    }
+}
+
+/// [`solve_soft`] applying every row to the bodies (the form before [`FrameVelocity`]): the
+/// oracle of the frame form's test.
+#[cfg(test)]
+pub(crate) fn solve_soft_rows(
+    c: &mut ContactConstraint,
+    a: &mut SolverBody,
+    b: &mut SolverBody,
+    inv_h: Real,
+    max_push: Real,
+    use_bias: bool,
+) {
+    solve_friction(c, a, b);
+    let (linear, soft) = (c.normal.dot(b.dp - a.dp), c.softness);
+    for p in c.points[..c.len].iter_mut() {
+        let row = &p.normal_row;
+        let s = p.separation + row.displacement(linear, a, b);
+        let (bias, mass_scale, impulse_scale) = soft_terms(soft, s, inv_h, max_push, use_bias);
         let vn = row.velocity(c.normal, a, b);
         let lambda = -row.mass * mass_scale * (vn + bias) - impulse_scale * p.normal_impulse;
         let new = (p.normal_impulse + lambda).max(0.0);

@@ -122,6 +122,21 @@ impl WideRow {
         linear + self.ang_b.dot(b.dq) - self.ang_a.dot(a.dq)
     }
 
+    /// `J v` given its linear part `u = d · (v_b − v_a)`, which the solve tracks per
+    /// constraint and direction (see [`solve_soft`]).
+    #[inline(always)]
+    fn velocity_from(&self, u: W, a: &WideBody, b: &WideBody) -> W {
+        u + self.ang_b.dot(b.w) - self.ang_a.dot(a.w)
+    }
+
+    /// The angular half of [`WideRow::apply`]; the linear half is applied once per
+    /// constraint (see [`solve_soft`]).
+    #[inline(always)]
+    fn apply_angular(&self, lambda: W, a: &mut WideBody, b: &mut WideBody) {
+        a.w = a.w.sub(self.inv_ang_a.scale(lambda));
+        b.w = b.w.add(self.inv_ang_b.scale(lambda));
+    }
+
     /// As `ContactRow::apply`.
     #[inline(always)]
     fn apply(&self, d: V3, lambda: W, a: &mut WideBody, b: &mut WideBody) {
@@ -442,17 +457,63 @@ pub(crate) fn warm_start(c: &mut WideConstraint, a: &mut WideBody, b: &mut WideB
     }
 }
 
-/// Coulomb friction, as `contact::solve_friction` in every lane.
+/// The linear velocities of a constraint's two body lanes during [`solve_soft`], tracked
+/// along the constraint's orthonormal frame instead of in the bodies: four lanes of
+/// `contact::FrameVelocity` (see there), with the same operations in the same order. Per
+/// row 3 lane operations instead of 22 (the linear dot product and the two linear updates),
+/// and the body velocities and the frame leave the registers during the point loops.
+struct Linear {
+    /// `n · (v_b − v_a)`, `t₀ · (v_b − v_a)`, `t₁ · (v_b − v_a)`.
+    u: [W; 3],
+    /// Sum of the impulse changes along `n`, `t₀`, `t₁`.
+    total: [W; 3],
+    /// `m_a⁻¹ + m_b⁻¹`.
+    inv_m: W,
+}
+
+impl Linear {
+    #[inline(always)]
+    fn new(c: &WideConstraint, a: &WideBody, b: &WideBody) -> Linear {
+        let dv = b.v.sub(a.v);
+        let zero = W::splat(0.0);
+        Linear {
+            u: [c.normal.dot(dv), c.tangent[0].dot(dv), c.tangent[1].dot(dv)],
+            total: [zero; 3],
+            inv_m: a.inv_m + b.inv_m,
+        }
+    }
+
+    /// Records impulse change `lambda` along direction `k` (0: normal, 1, 2: tangents).
+    #[inline(always)]
+    fn push(&mut self, k: usize, lambda: W) {
+        self.u[k] += lambda * self.inv_m;
+        self.total[k] += lambda;
+    }
+
+    /// Applies the summed linear impulse to both bodies.
+    #[inline(always)]
+    fn finish(&self, c: &WideConstraint, a: &mut WideBody, b: &mut WideBody) {
+        let [t0, t1] = c.tangent;
+        let imp = c
+            .normal
+            .scale(self.total[0])
+            .add(t0.scale(self.total[1]))
+            .add(t1.scale(self.total[2]));
+        a.v = a.v.sub(imp.scale(a.inv_m));
+        b.v = b.v.add(imp.scale(b.inv_m));
+    }
+}
+
+/// Coulomb friction, as `contact::solve_friction` in every lane (linear part in `lin`).
 #[inline(always)]
-fn solve_friction(c: &mut WideConstraint, a: &mut WideBody, b: &mut WideBody) {
-    let [t0, t1] = c.tangent;
+fn solve_friction(c: &mut WideConstraint, a: &mut WideBody, b: &mut WideBody, lin: &mut Linear) {
     let one = W::splat(1.0);
     for p in c.points[..c.len].iter_mut() {
         let [r0, r1] = &p.tangent_rows;
         let old = p.tangent_impulse;
         let new = [
-            old[0] - r0.mass * r0.velocity(t0, a, b),
-            old[1] - r1.mass * r1.velocity(t1, a, b),
+            old[0] - r0.mass * r0.velocity_from(lin.u[1], a, b),
+            old[1] - r1.mass * r1.velocity_from(lin.u[2], a, b),
         ];
         let max = c.friction * p.normal_impulse;
         let len_sq = new[0] * new[0] + new[1] * new[1];
@@ -460,13 +521,17 @@ fn solve_friction(c: &mut WideConstraint, a: &mut WideBody, b: &mut WideBody) {
         let scale = len_sq.simd_gt(max * max).select(max / len_sq.sqrt(), one);
         let new = [new[0] * scale, new[1] * scale];
         p.tangent_impulse = new;
-        r0.apply(t0, new[0] - old[0], a, b);
-        r1.apply(t1, new[1] - old[1], a, b);
+        let (d0, d1) = (new[0] - old[0], new[1] - old[1]);
+        r0.apply_angular(d0, a, b);
+        lin.push(1, d0);
+        r1.apply_angular(d1, a, b);
+        lin.push(2, d1);
     }
 }
 
 /// Soft-step solve (`b2SolveContactTwoPointsTask`), as `contact::solve_soft` in every lane:
-/// friction, then the normal rows with soft feedback when `use_bias` (relax otherwise).
+/// friction, then the normal rows with soft feedback when `use_bias` (relax otherwise). The
+/// linear velocities follow the constraint frame ([`Linear`]), as in the scalar routine.
 pub(crate) fn solve_soft(
     c: &mut WideConstraint,
     a: &mut WideBody,
@@ -475,7 +540,8 @@ pub(crate) fn solve_soft(
     max_push: Real,
     use_bias: bool,
 ) {
-    solve_friction(c, a, b);
+    let mut lin = Linear::new(c, a, b);
+    solve_friction(c, a, b, &mut lin);
     let (zero, one) = (W::splat(0.0), W::splat(1.0));
     let (inv_h, min_bias) = (W::splat(inv_h), W::splat(-max_push));
     let n = c.normal;
@@ -493,13 +559,16 @@ pub(crate) fn solve_soft(
         } else {
             (gap.select(s * inv_h, zero), one, zero)
         };
-        let vn = row.velocity(n, a, b);
+        let vn = row.velocity_from(lin.u[0], a, b);
         let lambda = -row.mass * mass_scale * (vn + bias) - impulse_scale * p.normal_impulse;
         let new = (p.normal_impulse + lambda).max(zero);
-        row.apply(n, new - p.normal_impulse, a, b);
+        let d = new - p.normal_impulse;
+        row.apply_angular(d, a, b);
+        lin.push(0, d);
         p.normal_impulse = new;
         p.max_normal_impulse = p.max_normal_impulse.max(new);
     }
+    lin.finish(c, a, b);
 }
 
 /// Whether any lane has restitution: the restitution pass skips the others entirely, as
