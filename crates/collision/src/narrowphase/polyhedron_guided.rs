@@ -2,9 +2,11 @@
 //! and the GJK/EPA contact of two polyhedron views, the fallback of the clipping paths.
 
 use super::contact::FeatureId;
+use super::dispatcher::as_polyhedron;
+use super::manifold::Separation;
 use super::polyhedron::{clip_faces, polyhedron_manifold_into, Polyhedron, FACE_PREFERENCE};
 use crate::math::{Isometry, Real, Vec3};
-use crate::query::contact_convex::{contact_gjk_epa_unguarded, GjkEpa};
+use crate::query::contact_convex::{contact_gjk_epa_unguarded_axis, GjkEpa};
 use crate::query::contact_cuboid_cuboid::{
     cuboid_cuboid_sat, cuboid_cuboid_witness, Axis, CuboidSat,
 };
@@ -13,7 +15,7 @@ use crate::query::gjk::{gjk, GjkResult};
 use crate::query::guard::{contact_is_consistent, remeasured_near};
 use crate::query::support_adapters::{Support, Transformed};
 use crate::query::Contact;
-use crate::shape::{ConvexHull, ConvexRef, Cuboid};
+use crate::shape::{ConvexHull, ConvexRef, Cuboid, Shape, SupportMap};
 use smallvec::SmallVec;
 
 /// The feature id of a single GJK/EPA point.
@@ -100,9 +102,47 @@ pub fn polyhedron_manifold_guided(
     prediction: Real,
     out: &mut Vec<(Contact, FeatureId)>,
 ) {
+    polyhedron_manifold_or_separation(a, b, ca, cb, pose_ab, prediction, out);
+}
+
+/// The built-in table's manifold of a hull against a hull or a box, `a` and `b` (B at
+/// `pose_ab`), appended to `out`, and a certificate that they are apart (see
+/// [`polyhedron_manifold_or_separation`]); `None` for other shapes, which write nothing.
+pub fn hull_manifold_or_separation(
+    a: &Shape,
+    b: &Shape,
+    pose_ab: &Isometry,
+    prediction: Real,
+    out: &mut Vec<(Contact, FeatureId)>,
+) -> Option<Separation> {
+    let (ca, cb) = (a.as_convex()?, b.as_convex()?);
+    let (pa, pb) = (as_polyhedron(ca)?, as_polyhedron(cb)?);
+    if pa.flat || pb.flat || pa.edges().len() * pb.edges().len() <= SAT_MAX_EDGE_PAIRS {
+        polyhedron_manifold_into(&pa, &pb, pose_ab, prediction, out);
+        return None;
+    }
+    polyhedron_manifold_or_separation(&pa, &pb, ca, cb, pose_ab, prediction, out)
+}
+
+/// [`polyhedron_manifold_guided`], returning, when GJK finds the shapes farther apart than
+/// the prediction, the separating axis it stopped on with the exact separation along it (two
+/// support queries), as a [`Separation`] for the manifold (`ContactManifold::apart`: the
+/// pair is skipped while the motion bound proves it still apart, as box–box pairs are).
+/// `None` for pairs in contact, for a box much larger than the hull, and when the measured
+/// separation does not exceed the prediction.
+#[allow(clippy::too_many_arguments)]
+pub fn polyhedron_manifold_or_separation(
+    a: &Polyhedron,
+    b: &Polyhedron,
+    ca: ConvexRef<'_>,
+    cb: ConvexRef<'_>,
+    pose_ab: &Isometry,
+    prediction: Real,
+    out: &mut Vec<(Contact, FeatureId)>,
+) -> Option<Separation> {
     if let (ConvexRef::Cuboid(x), ConvexRef::Cuboid(y)) = (ca, cb) {
         cuboid_cuboid_manifold_into(x, y, a, b, pose_ab, prediction, out);
-        return;
+        return None;
     }
     let near = match (ca, cb) {
         (ConvexRef::Cuboid(x), ConvexRef::ConvexHull(h)) => {
@@ -113,9 +153,35 @@ pub fn polyhedron_manifold_guided(
         }
         _ => false,
     };
-    if !near {
-        guided_general(a, b, ca, cb, pose_ab, prediction, out);
+    if near {
+        return None;
     }
+    guided_general(a, b, ca, cb, pose_ab, prediction, out)
+}
+
+/// The separation of `ca` and `cb` (B at `pose_ab`) along `axis` (A's frame, from A towards
+/// B), measured exactly, as a [`Separation`] when it exceeds `prediction`.
+fn separation_along(
+    ca: ConvexRef<'_>,
+    cb: ConvexRef<'_>,
+    pose_ab: &Isometry,
+    axis: Vec3,
+    prediction: Real,
+) -> Option<Separation> {
+    let u = axis.normalize_or_zero();
+    if u == Vec3::ZERO || !u.is_finite() {
+        return None;
+    }
+    let support_b = pose_ab.transform_point(cb.support(pose_ab.inverse_transform_vector(-u)));
+    let distance = u.dot(support_b) - u.dot(ca.support(u));
+    let b_box = cb.local_aabb();
+    let reach = b_box.center().length() + b_box.half_extents().length();
+    (distance > prediction && distance.is_finite() && reach.is_finite()).then_some(Separation {
+        pose_ab: *pose_ab,
+        axis: u,
+        distance,
+        reach,
+    })
 }
 
 /// A box whose largest half extent exceeds this many times the hull's reach (radius about its
@@ -196,7 +262,9 @@ fn large_box_hull(
     true
 }
 
-/// The guided path for pairs other than box–box: GJK/EPA, the guard's check, then clipping.
+/// The guided path for pairs other than box–box: GJK/EPA, the guard's check, then clipping;
+/// a separation certificate when GJK finds the shapes apart (see
+/// [`polyhedron_manifold_or_separation`]).
 fn guided_general(
     a: &Polyhedron,
     b: &Polyhedron,
@@ -205,14 +273,14 @@ fn guided_general(
     pose_ab: &Isometry,
     prediction: Real,
     out: &mut Vec<(Contact, FeatureId)>,
-) {
+) -> Option<Separation> {
     // GJK/EPA unguarded, then the guard's one check: the shapes' exact separation along the
     // returned normal must be the returned distance; when it is not (EPA on a degenerate
     // polytope, e.g. shapes touching within round-off), the full separating-axis test runs
     // instead (the guard's own fallback for polyhedra, here giving the whole manifold).
-    let c = match contact_gjk_epa_unguarded(ca, cb, pose_ab, prediction) {
-        GjkEpa::Beyond => return,
-        GjkEpa::Separated(c) | GjkEpa::Penetrating(c) => c,
+    let c = match contact_gjk_epa_unguarded_axis(ca, cb, pose_ab, prediction) {
+        (GjkEpa::Beyond, axis) => return separation_along(ca, cb, pose_ab, axis, prediction),
+        (GjkEpa::Separated(c) | GjkEpa::Penetrating(c), _) => c,
     };
     if !contact_is_consistent(ca, cb, pose_ab, &c) {
         // About half the failures on "1000 convex" are hulls touching within
@@ -227,13 +295,15 @@ fn guided_general(
         if let Some(k) = remeasured_near(ca, cb, pose_ab, &c, REMEASURE_SLACK) {
             clip_guided(a, b, k, pose_ab, prediction, out);
             if out.len() > start && out[start..].iter().all(|(_, id)| *id != EPA_FEATURE) {
-                return;
+                return None;
             }
             out.truncate(start);
         }
-        return polyhedron_manifold_into(a, b, pose_ab, prediction, out);
+        polyhedron_manifold_into(a, b, pose_ab, prediction, out);
+        return None;
     }
     clip_guided(a, b, c, pose_ab, prediction, out);
+    None
 }
 
 /// Box–box: the boxes' own separating-axis test (15 axes, exact) gives the normal; a face
