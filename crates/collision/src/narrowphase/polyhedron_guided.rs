@@ -220,7 +220,8 @@ fn large_box_hull(
     let he = x.half_extents();
     let hull_box = h.local_aabb();
     let reach = hull_box.center().length() + hull_box.half_extents().length();
-    if !(he.max_element() > LARGE_BOX_RATIO * reach) {
+    // (NaN sizes take the general path too.)
+    if he.max_element() <= LARGE_BOX_RATIO * reach || !reach.is_finite() {
         return false;
     }
     let (lo, hi) = h.rotated_bounds(pose_xh.rotation);
