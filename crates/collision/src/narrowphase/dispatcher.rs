@@ -19,6 +19,7 @@ use super::polyhedron::{
     plane_polyhedron_manifold, polyhedron_manifold_guided, polyhedron_manifold_into, Polyhedron,
     SAT_MAX_EDGE_PAIRS,
 };
+use super::polyhedron_guided::hull_manifold_or_separation;
 use super::triangle_cuboid::triangle_cuboid_manifold_into;
 use crate::error::{CaromError, Result};
 use crate::math::{Isometry, Real};
@@ -536,6 +537,15 @@ impl Dispatcher {
                         cfg.prediction,
                         contacts,
                     );
+                    true
+                }
+                // Hull–hull and hull–box directly too, keeping GJK's separating axis.
+                (Shape::ConvexHull(_), Shape::ConvexHull(_) | Shape::Cuboid(_))
+                | (Shape::Cuboid(_), Shape::ConvexHull(_))
+                    if self.user.is_empty() =>
+                {
+                    manifold.apart =
+                        hull_manifold_or_separation(a, b, &pose_ab, cfg.prediction, contacts);
                     true
                 }
                 _ => self.generate_into_with(a, b, &pose_ab, cfg, manifold.is_empty(), contacts)?,

@@ -280,28 +280,35 @@ pub(crate) fn clip_faces(
     // The incident face's corners placed by the pose's matrix (cheaper than a quaternion
     // rotation per corner).
     let (m, t) = (pose_ri.rotation_matrix(), pose_ri.translation);
-    let mut poly: Poly = inc
-        .face_loop(inc_face)
-        .iter()
-        .enumerate()
-        .map(|(k, &v)| (m * iv[v as usize] + t, id | ((k as u32 & 0xFF) << 8) | 0xFF))
-        .collect();
+    // Two buffers used in turn (swapping them moved both inline arrays at every clip).
+    let mut bufs: [Poly; 2] = [
+        inc.face_loop(inc_face)
+            .iter()
+            .enumerate()
+            .map(|(k, &v)| (m * iv[v as usize] + t, id | ((k as u32 & 0xFF) << 8) | 0xFF))
+            .collect(),
+        Poly::new(),
+    ];
+    let mut cur = 0;
     let lp = refp.face_loop(rf);
     let rv = refp.vertices();
-    let mut tmp = Poly::new();
     let first = lp.first().map_or(0, |&v| v as usize);
     let mut a = rv.get(first).copied().unwrap_or(Vec3::ZERO);
     for k in 0..lp.len() {
         let b = rv[lp.get(k + 1).map_or(first, |&v| v as usize)];
         // Side plane through the edge, not normalised (the clip is scale-invariant).
         let side = (b - a).cross(nr);
-        clip(&poly, side, side.dot(a), k as u32, &mut tmp);
+        let [b0, b1] = &mut bufs;
+        let (from, to) = if cur == 0 { (b0, b1) } else { (b1, b0) };
+        clip(from, side, side.dot(a), k as u32, to);
         a = b;
-        std::mem::swap(&mut poly, &mut tmp);
-        if poly.is_empty() {
+        cur = 1 - cur;
+        if bufs[cur].is_empty() {
             break;
         }
     }
+    let [b0, b1] = bufs;
+    let mut poly = if cur == 0 { b0 } else { b1 };
     if poly.is_empty() {
         // Deep or lateral configurations where the incident face misses the reference
         // face's prism: fall back to the deepest vertex of the incident shape among those

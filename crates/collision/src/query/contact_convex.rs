@@ -15,7 +15,7 @@ use super::contact_round::{
     contact_sphere_cuboid, contact_sphere_sphere, contact_sphere_triangle,
 };
 use super::epa::{epa, epa_polytope};
-use super::gjk::{gjk, gjk_intersects, GjkResult};
+use super::gjk::{gjk, gjk_intersects, gjk_with_direction, GjkResult};
 use super::guard::{guarded_contact, guarded_separated};
 use super::result::Contact;
 use super::support_adapters::{core_radius, AddRadius, Core, Transformed};
@@ -120,13 +120,28 @@ pub fn contact_gjk_epa_unguarded(
     pose_ab: &Isometry,
     prediction: Real,
 ) -> GjkEpa {
+    contact_gjk_epa_unguarded_axis(a, b, pose_ab, prediction).0
+}
+
+/// [`contact_gjk_epa_unguarded`], also returning, for [`GjkEpa::Beyond`], the direction
+/// (A's frame, from A towards B, not normalised) along which GJK found the shapes farther
+/// apart than the prediction; zero otherwise. A caller keeping it as a separating axis must
+/// measure the separation along it itself.
+#[inline]
+pub fn contact_gjk_epa_unguarded_axis(
+    a: ConvexRef<'_>,
+    b: ConvexRef<'_>,
+    pose_ab: &Isometry,
+    prediction: Real,
+) -> (GjkEpa, Vec3) {
     let (ra, rb) = (core_radius(a), core_radius(b));
     let radius = ra + rb;
     let core_a = Core(a);
     let core_b = Transformed::new(Core(b), pose_ab);
     let dir = -pose_ab.translation;
-    match gjk(&core_a, &core_b, dir, prediction + radius) {
-        GjkResult::BeyondMaxDistance => GjkEpa::Beyond,
+    let (result, v) = gjk_with_direction(&core_a, &core_b, dir, prediction + radius);
+    let c = match result {
+        GjkResult::BeyondMaxDistance => return (GjkEpa::Beyond, -v),
         GjkResult::Separated {
             distance,
             point_a,
@@ -134,7 +149,7 @@ pub fn contact_gjk_epa_unguarded(
         } => {
             let signed = distance - radius;
             if signed > prediction {
-                return GjkEpa::Beyond;
+                return (GjkEpa::Beyond, point_b - point_a);
             }
             let n = (point_b - point_a) / distance;
             GjkEpa::Separated(Contact {
@@ -182,7 +197,8 @@ pub fn contact_gjk_epa_unguarded(
                 normal: n,
             })
         }
-    }
+    };
+    (c, Vec3::ZERO)
 }
 
 /// Signed distance of two convex shapes in A's frame (always a result).

@@ -124,6 +124,19 @@ pub fn gjk<A: Support, B: Support>(
     initial_dir: Vec3,
     max_distance: Real,
 ) -> GjkResult {
+    gjk_with_direction(a, b, initial_dir, max_distance).0
+}
+
+/// [`gjk`], also returning its last direction `v` (the closest point of the simplex in
+/// `A - B` to the origin): for [`GjkResult::BeyondMaxDistance`], `-v` is an axis along which
+/// B lies beyond A by more than `max_distance` (`v · w > |v| max_distance` for the support
+/// point `w` of `A - B` along `-v`), which callers may keep as a separating axis.
+pub fn gjk_with_direction<A: Support, B: Support>(
+    a: &A,
+    b: &B,
+    initial_dir: Vec3,
+    max_distance: Real,
+) -> (GjkResult, Vec3) {
     let diff = MinkowskiDiff { a, b };
     let d0 = if initial_dir.length_squared() > 0.0 && initial_dir.is_finite() {
         initial_dir
@@ -140,13 +153,13 @@ pub fn gjk<A: Support, B: Support>(
     for _ in 0..GJK_MAX_ITERATIONS {
         let vv = v.length_squared();
         if vv <= GJK_ZERO_TOL * GJK_ZERO_TOL * scale_sq || !vv.is_finite() {
-            return GjkResult::Overlapping(simplex);
+            return (GjkResult::Overlapping(simplex), v);
         }
         let (w, pa, pb) = diff.support_pair(-v);
         scale_sq = scale_sq.max(w.length_squared());
         let vw = v.dot(w);
         if max_distance.is_finite() && vw > 0.0 && vw * vw > vv * max_distance * max_distance {
-            return GjkResult::BeyondMaxDistance;
+            return (GjkResult::BeyondMaxDistance, v);
         }
         if vv - vw <= GJK_REL_TOL * vv || simplex.contains(w) {
             break;
@@ -155,7 +168,7 @@ pub fn gjk<A: Support, B: Support>(
         simplex.push(w, pa, pb);
         let new_v = simplex.solve();
         if simplex.len == 4 {
-            return GjkResult::Overlapping(simplex);
+            return (GjkResult::Overlapping(simplex), v);
         }
         let new_vv = new_v.length_squared();
         if new_vv >= vv {
@@ -168,14 +181,17 @@ pub fn gjk<A: Support, B: Support>(
     }
     let vv = v.length_squared();
     if vv <= GJK_ZERO_TOL * GJK_ZERO_TOL * scale_sq {
-        return GjkResult::Overlapping(simplex);
+        return (GjkResult::Overlapping(simplex), v);
     }
     let (point_a, point_b) = simplex.witnesses();
-    GjkResult::Separated {
-        distance: vv.sqrt(),
-        point_a,
-        point_b,
-    }
+    (
+        GjkResult::Separated {
+            distance: vv.sqrt(),
+            point_a,
+            point_b,
+        },
+        v,
+    )
 }
 
 /// Boolean GJK: true when the sets, each swept by the given radius sum `radius`, intersect
