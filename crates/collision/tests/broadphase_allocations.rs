@@ -62,6 +62,14 @@ fn frame(bp: &mut impl BroadPhase, handles: &[ProxyHandle], step: usize) -> usiz
 
 #[test]
 fn a_steady_tree_broadphase_update_allocates_nothing() {
+    // Every box moves, so the update takes the split (parallel) descent: run it on a
+    // one-thread rayon pool, as the pipeline does (`pool.install`), so that every task runs
+    // on the counting thread and no parallel loop goes through rayon's injector queue (see
+    // below).
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .unwrap();
     let mut bp = TreeBroadPhase::default();
     let handles: Vec<ProxyHandle> = (0..1000)
         .map(|_| {
@@ -69,18 +77,20 @@ fn a_steady_tree_broadphase_update_allocates_nothing() {
                 .unwrap()
         })
         .collect();
-    for step in 0..48 {
-        frame(&mut bp, &handles, step);
-    }
-    let pairs = bp.pair_count();
-    COUNT.with(|n| n.set(0));
-    COUNTING.with(|c| c.set(true));
-    let mut changes = 0;
-    for step in 48..96 {
-        changes += frame(&mut bp, &handles, step);
-    }
-    COUNTING.with(|c| c.set(false));
-    let count = COUNT.with(|n| n.get());
+    let (pairs, changes, count) = pool.install(|| {
+        for step in 0..48 {
+            frame(&mut bp, &handles, step);
+        }
+        let pairs = bp.pair_count();
+        COUNT.with(|n| n.set(0));
+        COUNTING.with(|c| c.set(true));
+        let mut changes = 0;
+        for step in 48..96 {
+            changes += frame(&mut bp, &handles, step);
+        }
+        COUNTING.with(|c| c.set(false));
+        (pairs, changes, COUNT.with(|n| n.get()))
+    });
     assert!(pairs > 500, "the lattice pairs: {pairs}");
     assert!(changes > 100, "pairs came and went: {changes}");
     assert_eq!(count, 0, "allocations in 48 steady updates");

@@ -209,13 +209,27 @@ impl DynamicTree {
         &self,
         other: &DynamicTree,
         stack: &mut Vec<(u32, u32)>,
+        f: impl FnMut(u32, u32),
+    ) {
+        if self.root == NULL || other.root == NULL {
+            stack.clear();
+            return;
+        }
+        self.query_tree_from(other, (self.root, other.root), stack, f)
+    }
+
+    /// The descent of [`DynamicTree::query_tree_with`] from the node pair `start` (a node
+    /// of `self`, a node of `other`): one task of a split descent
+    /// ([`DynamicTree::tree_pair_tasks`]).
+    pub(crate) fn query_tree_from(
+        &self,
+        other: &DynamicTree,
+        start: (u32, u32),
+        stack: &mut Vec<(u32, u32)>,
         mut f: impl FnMut(u32, u32),
     ) {
         stack.clear();
-        if self.root == NULL || other.root == NULL {
-            return;
-        }
-        stack.push((self.root, other.root));
+        stack.push(start);
         while let Some((a, b)) = stack.pop() {
             let (na, nb) = (&self.nodes[a as usize], &other.nodes[b as usize]);
             if !na.aabb.intersects(&nb.aabb) {
@@ -291,13 +305,27 @@ impl DynamicTree {
     }
 
     /// [`DynamicTree::self_pairs`] with a caller-owned traversal stack (cleared first).
-    pub fn self_pairs_with(&self, stack: &mut Vec<(u32, u32)>, mut f: impl FnMut(u32, u32)) {
-        stack.clear();
+    pub fn self_pairs_with(&self, stack: &mut Vec<(u32, u32)>, f: impl FnMut(u32, u32)) {
         if self.root == NULL {
+            stack.clear();
             return;
         }
+        self.self_pairs_from((self.root, self.root), stack, f)
+    }
+
+    /// The descent of [`DynamicTree::self_pairs_with`] from the node pair `start`: the
+    /// pairs within one subtree when `start.0 == start.1`, else the pairs between two
+    /// disjoint subtrees whose boxes intersect. One task of a split descent
+    /// ([`DynamicTree::self_pair_tasks`]).
+    pub(crate) fn self_pairs_from(
+        &self,
+        start: (u32, u32),
+        stack: &mut Vec<(u32, u32)>,
+        mut f: impl FnMut(u32, u32),
+    ) {
+        stack.clear();
         let nodes = &self.nodes;
-        stack.push((self.root, self.root));
+        stack.push(start);
         let push = |stack: &mut Vec<(u32, u32)>, a: u32, b: u32| {
             if nodes[a as usize].aabb.intersects(&nodes[b as usize].aabb) {
                 stack.push((a, b));
@@ -333,6 +361,131 @@ impl DynamicTree {
                         push(stack, a, nb.child2);
                     }
                 }
+            }
+        }
+    }
+
+    /// Splits the self-pair descent ([`DynamicTree::self_pairs_with`]) at the top levels of
+    /// the tree into independent node-pair tasks for [`DynamicTree::self_pairs_from`], for a
+    /// parallel sweep. The node pairs are expanded by the descent's own rules, level by
+    /// level, until there are at least `min_tasks` or nothing is left to expand, so the
+    /// tasks report together exactly the pairs of the whole descent, each once. The list
+    /// depends only on the tree, never on the thread count. (The descent is Bullet's
+    /// `btDbvt::collideTT`; the breadth-first cut into a task list is ours.)
+    pub(crate) fn self_pair_tasks(
+        &self,
+        min_tasks: usize,
+        tasks: &mut Vec<(u32, u32)>,
+        scratch: &mut Vec<(u32, u32)>,
+    ) {
+        tasks.clear();
+        if self.root == NULL {
+            return;
+        }
+        tasks.push((self.root, self.root));
+        let nodes = &self.nodes;
+        while tasks.len() < min_tasks {
+            scratch.clear();
+            let mut expanded = false;
+            let overlap =
+                |a: u32, b: u32| nodes[a as usize].aabb.intersects(&nodes[b as usize].aabb);
+            for &(a, b) in tasks.iter() {
+                let na = &nodes[a as usize];
+                if a == b {
+                    if !na.is_leaf() {
+                        expanded = true;
+                        scratch.push((na.child1, na.child1));
+                        scratch.push((na.child2, na.child2));
+                        if overlap(na.child1, na.child2) {
+                            scratch.push((na.child1, na.child2));
+                        }
+                    }
+                    // A leaf alone has no pair.
+                    continue;
+                }
+                let nb = &nodes[b as usize];
+                let split_a = match (na.is_leaf(), nb.is_leaf()) {
+                    (true, true) => {
+                        scratch.push((a, b));
+                        continue;
+                    }
+                    (true, false) => false,
+                    (false, true) => true,
+                    (false, false) => na.height >= nb.height,
+                };
+                expanded = true;
+                let pairs = if split_a {
+                    [(na.child1, b), (na.child2, b)]
+                } else {
+                    [(a, nb.child1), (a, nb.child2)]
+                };
+                for (x, y) in pairs {
+                    if overlap(x, y) {
+                        scratch.push((x, y));
+                    }
+                }
+            }
+            std::mem::swap(tasks, scratch);
+            if !expanded {
+                break;
+            }
+        }
+    }
+
+    /// Splits the tree-vs-tree descent ([`DynamicTree::query_tree_with`] of `self` against
+    /// `other`) into independent node-pair tasks for [`DynamicTree::query_tree_from`], like
+    /// [`DynamicTree::self_pair_tasks`]: expanded by the descent's rules, level by level,
+    /// until there are at least `min_tasks` or nothing is left to expand. Only node pairs
+    /// whose boxes intersect are kept.
+    pub(crate) fn tree_pair_tasks(
+        &self,
+        other: &DynamicTree,
+        min_tasks: usize,
+        tasks: &mut Vec<(u32, u32)>,
+        scratch: &mut Vec<(u32, u32)>,
+    ) {
+        tasks.clear();
+        if self.root == NULL || other.root == NULL {
+            return;
+        }
+        let overlap = |a: u32, b: u32| {
+            self.nodes[a as usize]
+                .aabb
+                .intersects(&other.nodes[b as usize].aabb)
+        };
+        if !overlap(self.root, other.root) {
+            return;
+        }
+        tasks.push((self.root, other.root));
+        while tasks.len() < min_tasks {
+            scratch.clear();
+            let mut expanded = false;
+            for &(a, b) in tasks.iter() {
+                let (na, nb) = (&self.nodes[a as usize], &other.nodes[b as usize]);
+                let split_a = match (na.is_leaf(), nb.is_leaf()) {
+                    (true, true) => {
+                        scratch.push((a, b));
+                        continue;
+                    }
+                    (true, false) => false,
+                    (false, true) => true,
+                    (false, false) => na.aabb.surface_area() >= nb.aabb.surface_area(),
+                };
+                expanded = true;
+                let pairs = if split_a {
+                    [(na.child1, b), (na.child2, b)]
+                } else {
+                    [(a, nb.child1), (a, nb.child2)]
+                };
+                for (x, y) in pairs {
+                    if overlap(x, y) {
+                        scratch.push((x, y));
+                    }
+                }
+            }
+            std::mem::swap(tasks, scratch);
+            if !expanded {
+                break;
             }
         }
     }
