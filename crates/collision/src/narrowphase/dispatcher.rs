@@ -89,6 +89,17 @@ pub fn as_polyhedron(c: ConvexRef<'_>) -> Option<Polyhedron<'_>> {
     }
 }
 
+/// Whether [`as_polyhedron`] gives a view of `c`, without building it (the dispatch guards
+/// of [`convex_convex_into`] run once per mesh triangle, where building the triangle's view
+/// three times to test and use it was measurable).
+#[inline]
+fn is_polyhedral(c: ConvexRef<'_>) -> bool {
+    matches!(
+        c,
+        ConvexRef::Cuboid(_) | ConvexRef::ConvexHull(_) | ConvexRef::Triangle(_)
+    )
+}
+
 /// Convex A against convex B (see the module docs of [`super::convex`] and
 /// [`super::polyhedron`]).
 pub fn convex_convex(
@@ -134,12 +145,12 @@ pub fn convex_convex_into(
             out.extend(capsule_cuboid_manifold(x, y, pose_ab, pred));
             true
         }
-        (C::Capsule(x), _) if as_polyhedron(b).is_some() => {
+        (C::Capsule(x), _) if is_polyhedral(b) => {
             let pb = as_polyhedron(b).expect("checked");
             out.extend(capsule_polyhedron_manifold(x, b, &pb, pose_ab, pred));
             true
         }
-        (_, C::Capsule(_)) if as_polyhedron(a).is_some() => swapped(out),
+        (_, C::Capsule(_)) if is_polyhedral(a) => swapped(out),
         (C::Triangle(t), C::Cuboid(c)) => {
             triangle_cuboid_manifold_into(t, c, pose_ab, pred, out);
             true
@@ -291,7 +302,7 @@ fn triangles_convex_into<M: ContactTriangles>(
     // Shapes without one-shot manifolds (cylinders, cones, scaled shapes) use the hybrid
     // method: perturbation when the cache is empty, single points after.
     let incremental =
-        as_polyhedron(cb).is_none() && !matches!(cb, ConvexRef::Sphere(_) | ConvexRef::Capsule(_));
+        !is_polyhedral(cb) && !matches!(cb, ConvexRef::Sphere(_) | ConvexRef::Capsule(_));
     let full = want_full && incremental;
     if let ConvexRef::ConvexHull(h) = cb {
         mesh_hull_contacts(m, h, pose_ab, cfg.prediction, out);
