@@ -198,17 +198,40 @@ pub fn correct_internal_edge(
     let Some(face_n) = tri.normal() else {
         return false;
     };
+    correct_internal_edge_with(edges, tri, face_n, edge_tolerance(tri), b, pose_ab, c)
+}
+
+/// The distance within which a contact point counts as on an edge of `tri` for
+/// [`correct_internal_edge`]: relative to the triangle's longest edge.
+#[inline]
+fn edge_tolerance(tri: &Triangle) -> Real {
+    let v = tri.vertices();
+    let scale = (v[1] - v[0])
+        .length()
+        .max((v[2] - v[1]).length())
+        .max((v[0] - v[2]).length());
+    1.0e-3 * scale + 1.0e-5
+}
+
+/// [`correct_internal_edge`] with the triangle's unit normal `face_n` (`tri.normal()`) and
+/// [`edge_tolerance`] given, so a triangle's contacts share them (the same values, computed
+/// once per triangle instead of once per contact).
+#[inline]
+fn correct_internal_edge_with(
+    edges: &[MeshEdge; 3],
+    tri: &Triangle,
+    face_n: Vec3,
+    tol: Real,
+    b: ConvexRef<'_>,
+    pose_ab: &Isometry,
+    c: &mut Contact,
+) -> bool {
     let n = c.normal;
     let cos_n = n.dot(face_n);
     if !(-1.0e-3..=1.0 - 1.0e-6).contains(&cos_n) {
         return false;
     }
     let v = tri.vertices();
-    let scale = (v[1] - v[0])
-        .length()
-        .max((v[2] - v[1]).length())
-        .max((v[0] - v[2]).length());
-    let tol = 1.0e-3 * scale + 1.0e-5;
     for k in 0..3 {
         let (p, q) = (v[k], v[(k + 1) % 3]);
         let (_, d) = closest_point_segment(c.point_a, p, q);
@@ -290,10 +313,11 @@ fn contacts_in_box<M: ContactTriangles + ?Sized>(
             continue;
         }
         let edges = mesh.triangle_edges(t);
+        let tol = edge_tolerance(&tri);
         let mut keep = start;
         for i in start..out.len() {
             let (mut c, id) = out[i];
-            correct_internal_edge(&edges, &tri, b, pose_ab, &mut c);
+            correct_internal_edge_with(&edges, &tri, n, tol, b, pose_ab, &mut c);
             if c.distance <= prediction && c.distance.is_finite() && c.normal.is_finite() {
                 out[keep] = (c, mix_feature(t, id));
                 keep += 1;
