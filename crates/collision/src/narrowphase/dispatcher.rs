@@ -578,3 +578,61 @@ impl Dispatcher {
         })
     }
 }
+
+#[cfg(test)]
+mod polyhedral_tests {
+    use super::{as_polyhedron, is_polyhedral};
+    use crate::math::Vec3;
+    use crate::shape::{
+        Capsule, Cone, ConvexHull, ConvexRef, Cuboid, Cylinder, Scaled, Shape, Sphere, Triangle,
+    };
+    use std::sync::Arc;
+
+    /// The cheap dispatch guard agrees with building the view, for every kind of convex
+    /// (including a degenerate triangle, whose view still exists).
+    #[test]
+    fn is_polyhedral_matches_as_polyhedron() {
+        let sphere = Sphere::new(0.5).unwrap();
+        let cuboid = Cuboid::new(Vec3::new(0.3, 0.4, 0.5)).unwrap();
+        let capsule = Capsule::new(0.2, 0.6).unwrap();
+        let cylinder = Cylinder::new(0.3, 0.7).unwrap();
+        let cone = Cone::new(0.3, 0.7).unwrap();
+        let pts = [
+            Vec3::ZERO,
+            Vec3::X,
+            Vec3::Y,
+            Vec3::Z,
+            Vec3::new(1.0, 1.0, 1.0),
+        ];
+        let hull = ConvexHull::new(&pts).unwrap();
+        let tri = Triangle {
+            a: Vec3::ZERO,
+            b: Vec3::X,
+            c: Vec3::Y,
+        };
+        let flat = Triangle {
+            a: Vec3::ZERO,
+            b: Vec3::X,
+            c: Vec3::X * 2.0,
+        };
+        let scaled =
+            Scaled::new(Arc::new(Shape::Cuboid(cuboid)), Vec3::new(2.0, 1.0, 0.5)).unwrap();
+        let all = [
+            ConvexRef::Sphere(&sphere),
+            ConvexRef::Cuboid(&cuboid),
+            ConvexRef::Capsule(&capsule),
+            ConvexRef::Cylinder(&cylinder),
+            ConvexRef::Cone(&cone),
+            ConvexRef::ConvexHull(&hull),
+            ConvexRef::Triangle(&tri),
+            ConvexRef::Triangle(&flat),
+            ConvexRef::Scaled(&scaled),
+        ];
+        let mut polyhedral = 0;
+        for c in all {
+            assert_eq!(is_polyhedral(c), as_polyhedron(c).is_some(), "{c:?}");
+            polyhedral += usize::from(is_polyhedral(c));
+        }
+        assert_eq!(polyhedral, 4);
+    }
+}
