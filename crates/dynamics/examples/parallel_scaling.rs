@@ -55,12 +55,30 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut times = [[vec![], vec![], vec![]], [vec![], vec![], vec![]]];
     let mut ratios = vec![];
     let mut controls = vec![];
+    // Per side: the solver's sub-stages (islands, prepare, forces, warm start, solve,
+    // integrate, relax, restitution, store), per step.
+    let mut subs: [[Vec<f64>; 9]; 2] = Default::default();
     for _ in 0..steps {
         let mut wall = [0.0; 2];
         for side in 0..2 {
             let w = &mut worlds[side];
             let t0 = Instant::now();
-            let t = pools[side].install(|| w.step(scene.dt).map(|r| r.timings))?;
+            let (t, d) = pools[side]
+                .install(|| w.step(scene.dt).map(|r| (r.timings, r.dynamics.timings)))?;
+            let parts = [
+                d.islands,
+                d.prepare,
+                d.forces,
+                d.warm_start,
+                d.solve,
+                d.integrate,
+                d.relax,
+                d.restitution,
+                d.store,
+            ];
+            for (v, p) in subs[side].iter_mut().zip(parts) {
+                v.push(p.as_secs_f64() * 1e3);
+            }
             wall[side] = t0.elapsed().as_secs_f64() * 1e3;
             times[side][0].push(wall[side]);
             times[side][1].push((t.solver + t.islands).as_secs_f64() * 1e3);
@@ -96,6 +114,22 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         median(&mut ratios),
         median(&mut controls),
     );
+    let names = [
+        "islands",
+        "prepare",
+        "forces",
+        "warm start",
+        "solve",
+        "integrate",
+        "relax",
+        "restitution",
+        "store",
+    ];
+    for (k, name) in names.iter().enumerate() {
+        let a = median(&mut subs[0][k]);
+        let b = median(&mut subs[1][k]);
+        println!("  {name:<12} {a:.3} vs {b:.3} ms = {:.2}x", a / b);
+    }
     if !same {
         return Err("the two runs differ".into());
     }

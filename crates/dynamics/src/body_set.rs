@@ -267,8 +267,8 @@ impl BodySet {
 
     /// Recomputes the world inverse inertia `R I⁻¹ Rᵀ` of slot `i` from its rotation.
     pub(crate) fn update_world_inertia(&mut self, i: usize) {
-        let r = Mat3::from_quat(self.rotation[i]);
-        self.inv_inertia_world[i] = r * self.info[i].inv_inertia_local * r.transpose();
+        self.inv_inertia_world[i] =
+            world_inertia(self.rotation[i], &self.info[i].inv_inertia_local);
     }
 
     /// Cold data of a body.
@@ -433,4 +433,12 @@ impl BodySet {
         }
         e
     }
+}
+
+/// The world inverse inertia `R I⁻¹ Rᵀ` of a body with rotation `q` and local inverse inertia
+/// `inv_local` ([`BodySet::update_world_inertia`], and the soft step's parallel store).
+#[inline]
+pub(crate) fn world_inertia(q: Quat, inv_local: &Mat3) -> Mat3 {
+    let r = Mat3::from_quat(q);
+    r * *inv_local * r.transpose()
 }

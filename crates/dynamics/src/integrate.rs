@@ -334,9 +334,16 @@ pub(crate) fn store(set: &mut BodySet, bodies: &[SolverBody]) {
             set.angular_velocity[i] = b.w;
             set.update_world_inertia(i);
         }
-        set.force[i] = Vec3::ZERO;
-        set.torque[i] = Vec3::ZERO;
     }
+    clear_forces(set, bodies.len());
+}
+
+/// Zeroes the force and torque accumulators of slots `..n` (the end of a step; the soft step
+/// stores the velocities and world inertias in its parallel stages and then calls this).
+pub(crate) fn clear_forces(set: &mut BodySet, n: usize) {
+    let n = n.min(set.force.len()).min(set.torque.len());
+    set.force[..n].fill(Vec3::ZERO);
+    set.torque[..n].fill(Vec3::ZERO);
 }
 
 #[cfg(test)]

@@ -279,7 +279,7 @@ impl DynamicsWorld {
         }
 
         let t = Instant::now();
-        integrate::store(&mut self.bodies, &self.solver_bodies);
+        // (The solvers stored the velocities and world inertias and cleared the forces.)
         for (jh, j) in self.joints.iter_mut() {
             let peak = j.impulses.iter().fold(0.0 as Real, |m, x| m.max(x.abs()));
             if !j.broken && peak > j.desc.break_impulse {

@@ -177,7 +177,6 @@ fn solver_allocations(kind: SolverKind, steps: usize, with_joints: bool) -> Vec<
             SolverKind::SoftStep => soft_step::step(&mut ctx),
             SolverKind::SequentialImpulse => sequential::step(&mut ctx),
         }));
-        integrate::store(&mut set, &bodies);
     }
     // The stack really was solved: every contact carries weight, every joint has rows.
     assert!(manifolds.iter().all(|m| m.total_normal_impulse() > 0.0));

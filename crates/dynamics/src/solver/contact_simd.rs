@@ -28,8 +28,10 @@ use std::ops::Range;
 #[path = "contact_simd_build.rs"]
 mod build;
 #[cfg(test)]
+pub(crate) use build::store;
+#[cfg(test)]
 pub(crate) use build::{build, write_back};
-pub(crate) use build::{fill, store};
+pub(crate) use build::{fill, store_range};
 
 /// Maps a scalar type to its four-lane vector.
 pub(crate) trait Lanes {

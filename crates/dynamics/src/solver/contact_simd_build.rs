@@ -393,14 +393,45 @@ pub(crate) fn build(
 
 /// Writes the accumulated impulses (scaled to per-step units) and the friction direction of
 /// every lane into its manifold, as `contact::store` does for scalar constraints.
+#[cfg(test)]
 pub(crate) fn store(wide: &WideScratch, manifolds: &mut [ContactManifold], scale: Real) {
-    for w in &wide.cons {
+    let range = 0..wide.cons.len();
+    // SAFETY: both pointers come from live slices of the given lengths, borrowed here.
+    unsafe {
+        store_range(
+            wide.cons.as_ptr(),
+            range,
+            manifolds.as_mut_ptr(),
+            manifolds.len(),
+            scale,
+        );
+    }
+}
+
+/// [`store`] of the wide constraints `range` of `cons` into the manifolds behind
+/// `manifolds` (`len` of them): one block of the soft step's parallel store stage (module
+/// `soft_stages`). Each manifold is in one lane of one wide constraint, so blocks of
+/// disjoint ranges write disjoint manifolds.
+///
+/// # Safety
+/// `cons` points to at least `range.end` constraints and `manifolds` to `len` manifolds;
+/// during the call nothing else touches those constraints or the manifolds of their lanes.
+pub(crate) unsafe fn store_range(
+    cons: *const WideConstraint,
+    range: Range<usize>,
+    manifolds: *mut ContactManifold,
+    len: usize,
+    scale: Real,
+) {
+    for i in range {
+        let w = &*cons.add(i);
         for l in 0..LANES {
             let m_index = w.manifold[l];
             if m_index == NONE {
                 continue;
             }
-            let m = &mut manifolds[m_index];
+            assert!(m_index < len);
+            let m = &mut *manifolds.add(m_index);
             m.tangent = get3(&w.tangent[0], l);
             for (out, wp) in m.points_mut().iter_mut().zip(&w.points[..w.lens[l]]) {
                 out.normal_impulse = wp.normal_impulse.as_array()[l] * scale;

@@ -78,5 +78,6 @@ pub(crate) fn step(ctx: &mut StepContext) {
 
     contact::store(cons, ctx.manifolds, 1.0);
     joints::store(rows, ctx.joints, 1.0);
+    integrate::store(ctx.set, ctx.bodies);
     lap(&mut t, &mut ctx.timings.store);
 }

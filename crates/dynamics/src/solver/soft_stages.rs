@@ -6,7 +6,10 @@
 //! (blocks of constraints), then the contact overflow colour (one block); solve likewise;
 //! integrate positions (blocks of bodies); refresh and relax every joint colour (each joint
 //! refreshes its rows, then solves), relax every contact colour and the overflow colour.
-//! After the last substep: restitution over the colours and the overflow colour. This is
+//! After the last substep: restitution over the colours and the overflow colour; then the
+//! store (velocities and world inertias into the body set in blocks of bodies, the wide
+//! constraints' impulses into their manifolds in blocks of wide constraints, as Box2D v3's
+//! `b2FinalizeBodies` and `b2StoreImpulses` stages). This is
 //! exactly the order of the sequential solve, and inside a stage the blocks touch disjoint
 //! bodies (a colour's constraints share no dynamic body; a body stage handles each body
 //! once), so the result is the same bits whatever the thread count. Block sizes are
@@ -20,10 +23,11 @@ use super::contact_simd::{self, WideBody, WideConstraint};
 use super::joints::{JointPass, JointScratch, JointView};
 use super::stages::{block_count, block_range, StageList};
 use super::{Softness, SolverBody};
-use crate::body_set::BodySet;
+use crate::body_set::{world_inertia, BodyInfo, BodySet};
+use crate::contact::ContactManifold;
 use crate::integrate::{self, BodyTerms};
 use crate::joint::JointSet;
-use carom_collision::math::{Quat, Real, Vec3};
+use carom_collision::math::{Mat3, Quat, Real, Vec3};
 use std::ops::Range;
 
 /// Bodies per block of the body stages.
@@ -32,6 +36,8 @@ pub(crate) const BODY_BLOCK: usize = 128;
 pub(crate) const WIDE_BLOCK: usize = 16;
 /// Scalar constraints per block of a colour stage (SIMD off).
 pub(crate) const SCALAR_BLOCK: usize = 64;
+/// Wide constraints per block of the impulse store stage.
+pub(crate) const STORE_BLOCK: usize = 64;
 /// Joints per block of a joint colour stage.
 pub(crate) const JOINT_BLOCK: usize = 32;
 /// Scalar constraints a joint counts as when its colour is compared with
@@ -70,6 +76,12 @@ pub(crate) enum SoftStage {
     Serial(Pass, u8, u8),
     /// Speed clamp and position update, in blocks of bodies.
     IntegratePositions,
+    /// After the last pass: velocities back into the body set and the world inverse
+    /// inertias refreshed from the new rotations (`integrate::store`), in blocks of bodies.
+    StoreBodies,
+    /// After the last pass: the wide constraints' impulses back into their manifolds
+    /// (`contact_simd::store`), in blocks of [`STORE_BLOCK`] wide constraints.
+    StoreImpulses,
 }
 
 /// What the stage list of a step depends on.
@@ -89,6 +101,8 @@ pub(crate) struct Shape<'a> {
     /// Colours of fewer scalar constraints are one block ([`super::SolverParams`]'s
     /// `parallel_min_batch`).
     pub min_batch: usize,
+    /// Wide constraints whose impulses the store stage writes back (0 without SIMD).
+    pub wide: usize,
 }
 
 impl Shape<'_> {
@@ -175,6 +189,8 @@ pub(crate) fn plan(list: &mut StageList<SoftStage>, s: &Shape) {
         s.pass(list, Pass::Relax);
     }
     s.pass(list, Pass::Restitution);
+    list.push(SoftStage::StoreBodies, body_blocks);
+    list.push(SoftStage::StoreImpulses, block_count(s.wide, STORE_BLOCK));
 }
 
 /// Per-step constants of the passes.
@@ -186,6 +202,8 @@ pub(crate) struct Consts {
     pub max_push: Real,
     pub restitution_threshold: Real,
     pub simd: bool,
+    /// Factor of the stored impulses (per substep to per step: the substep count).
+    pub impulse_scale: Real,
 }
 
 /// Raw views of everything the blocks write, shared by the threads of the region.
@@ -199,6 +217,13 @@ struct Shared<'a> {
     position: *mut Vec3,
     rotation: *mut Quat,
     n_poses: usize,
+    linear_velocity: *mut Vec3,
+    angular_velocity: *mut Vec3,
+    inv_inertia_world: *mut Mat3,
+    info: *const BodyInfo,
+    n_store: usize,
+    manifolds: *mut ContactManifold,
+    n_manifolds: usize,
     wide: *mut WideConstraint,
     n_wide: usize,
     colours: &'a [Range<usize>],
@@ -226,8 +251,17 @@ pub(crate) fn run(
     scratch: &mut ContactScratch,
     rows: &mut JointScratch,
     joints: &JointSet,
+    manifolds: &mut [ContactManifold],
 ) {
     let n_poses = set.position.len().min(set.rotation.len());
+    let n_store = [
+        set.linear_velocity.len(),
+        set.angular_velocity.len(),
+        set.inv_inertia_world.len(),
+        set.info.len(),
+    ]
+    .into_iter()
+    .fold(n_poses, usize::min);
     let (colours, overflow) = if c.simd {
         (&scratch.wide.ranges[..], scratch.wide.overflow.clone())
     } else {
@@ -244,6 +278,13 @@ pub(crate) fn run(
         position: set.position.as_mut_ptr(),
         rotation: set.rotation.as_mut_ptr(),
         n_poses,
+        linear_velocity: set.linear_velocity.as_mut_ptr(),
+        angular_velocity: set.angular_velocity.as_mut_ptr(),
+        inv_inertia_world: set.inv_inertia_world.as_mut_ptr(),
+        info: set.info.as_ptr(),
+        n_store,
+        n_manifolds: manifolds.len(),
+        manifolds: manifolds.as_mut_ptr(),
         set,
         n_wide: scratch.wide.cons.len(),
         wide: scratch.wide.cons.as_mut_ptr(),
@@ -292,6 +333,25 @@ impl Shared<'_> {
                     let b = &mut *self.bodies.add(s);
                     integrate::clamp_and_integrate_position(t, p, q, b, c.h);
                 }
+            }
+            SoftStage::StoreBodies => {
+                for i in block_range(self.n_terms, blocks, block) {
+                    let s = (*self.terms.add(i)).slot();
+                    assert!(s < self.n_bodies && s < self.n_store);
+                    let b = &*self.bodies.add(s);
+                    if b.dynamic {
+                        *self.linear_velocity.add(s) = b.v;
+                        *self.angular_velocity.add(s) = b.w;
+                        let inv_local = &(*self.info.add(s)).inv_inertia_local;
+                        *self.inv_inertia_world.add(s) =
+                            world_inertia(*self.rotation.add(s), inv_local);
+                    }
+                }
+            }
+            SoftStage::StoreImpulses => {
+                let b = block_range(self.n_wide, blocks, block);
+                let (m, n) = (self.manifolds, self.n_manifolds);
+                contact_simd::store_range(self.wide, b, m, n, c.impulse_scale);
             }
             SoftStage::Joints(pass, k) => {
                 let pass = match pass {

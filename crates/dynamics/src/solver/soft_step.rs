@@ -12,7 +12,8 @@
 //! Everything from the first substep to the restitution pass is one list of stages (module
 //! `stages`, Box2D's `b2SolverStage`s) run in one parallel region: the body stages in blocks
 //! of bodies, each joint and contact colour in blocks of constraints, the overflow colours
-//! as single blocks (module `soft_stages`).
+//! as single blocks, and the store of the velocities, world inertias and wide constraints'
+//! impulses (module `soft_stages`).
 
 use super::soft_stages::{self, Pass, SoftStage};
 use super::stages::thread_count;
@@ -80,6 +81,7 @@ pub(crate) fn step(ctx: &mut StepContext) {
         overflow,
         bodies: terms.len(),
         min_batch: p.parallel_min_batch,
+        wide: if simd { scratch.wide.cons.len() } else { 0 },
     };
     soft_stages::plan(plan, &shape);
     let consts = soft_stages::Consts {
@@ -89,16 +91,27 @@ pub(crate) fn step(ctx: &mut StepContext) {
         max_push: p.max_push_velocity,
         restitution_threshold: p.restitution_threshold,
         simd,
+        impulse_scale: n as Real,
     };
     lap(&mut t, &mut ctx.timings.prepare);
 
     soft_stages::run(
-        plan, threads, consts, ctx.set, ctx.bodies, terms, scratch, rows, ctx.joints,
+        plan,
+        threads,
+        consts,
+        ctx.set,
+        ctx.bodies,
+        terms,
+        scratch,
+        rows,
+        ctx.joints,
+        ctx.manifolds,
     );
     for (kind, d) in plan.durations() {
         let slot = match kind {
             SoftStage::IntegrateVelocities => &mut ctx.timings.forces,
             SoftStage::IntegratePositions => &mut ctx.timings.integrate,
+            SoftStage::StoreBodies | SoftStage::StoreImpulses => &mut ctx.timings.store,
             SoftStage::Joints(pass, _)
             | SoftStage::Colour(pass, _)
             | SoftStage::Serial(pass, _, _) => match pass {
@@ -112,10 +125,10 @@ pub(crate) fn step(ctx: &mut StepContext) {
     }
     t = Instant::now();
 
-    if simd {
-        contact_simd::store(&scratch.wide, ctx.manifolds, n as Real);
-    }
+    // The wide constraints' impulses, the velocities and the world inertias were stored by
+    // the last stages; what is left is serial and small.
     contact::store(&scratch.cons, ctx.manifolds, n as Real);
     joints::store(rows, ctx.joints, n as Real);
+    integrate::clear_forces(ctx.set, ctx.bodies.len());
     lap(&mut t, &mut ctx.timings.store);
 }
