@@ -536,6 +536,13 @@ impl Dispatcher {
             };
             contacts.clear();
             pts.clear();
+            // A hull pair's last normal (world, from B towards A) or separating axis seeds
+            // GJK (read before the certificate is cleared).
+            let hint = match (manifold.points.first(), &manifold.apart) {
+                (Some(p), _) => Some(-pose_a.inverse_transform_vector(p.normal)),
+                (None, Some(s)) => Some(s.axis),
+                (None, None) => None,
+            };
             manifold.apart = None;
             let full = match (a, b) {
                 // Box–box directly (the built-in table's choice), keeping the separating axis
@@ -556,7 +563,7 @@ impl Dispatcher {
                     if self.user.is_empty() =>
                 {
                     manifold.apart =
-                        hull_manifold_or_separation(a, b, &pose_ab, cfg.prediction, contacts);
+                        hull_manifold_or_separation(a, b, &pose_ab, cfg.prediction, hint, contacts);
                     true
                 }
                 _ => self.generate_into_with(a, b, &pose_ab, cfg, manifold.is_empty(), contacts)?,

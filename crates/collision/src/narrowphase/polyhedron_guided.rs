@@ -6,7 +6,7 @@ use super::dispatcher::as_polyhedron;
 use super::manifold::Separation;
 use super::polyhedron::{clip_faces, polyhedron_manifold_into, Polyhedron, FACE_PREFERENCE};
 use crate::math::{Isometry, Real, Vec3};
-use crate::query::contact_convex::{contact_gjk_epa_unguarded_axis, GjkEpa};
+use crate::query::contact_convex::{contact_gjk_epa_unguarded_hinted, GjkEpa};
 use crate::query::contact_cuboid_cuboid::{
     cuboid_cuboid_sat, cuboid_cuboid_witness, Axis, CuboidSat,
 };
@@ -108,11 +108,15 @@ pub fn polyhedron_manifold_guided(
 /// The built-in table's manifold of a hull against a hull or a box, `a` and `b` (B at
 /// `pose_ab`), appended to `out`, and a certificate that they are apart (see
 /// [`polyhedron_manifold_or_separation`]); `None` for other shapes, which write nothing.
+/// `hint` is a guess of the contact normal (A's frame, from A towards B: the persistent
+/// manifold's last normal) that seeds GJK; the answer does not depend on it beyond
+/// round-off.
 pub fn hull_manifold_or_separation(
     a: &Shape,
     b: &Shape,
     pose_ab: &Isometry,
     prediction: Real,
+    hint: Option<Vec3>,
     out: &mut Vec<(Contact, FeatureId)>,
 ) -> Option<Separation> {
     let (ca, cb) = (a.as_convex()?, b.as_convex()?);
@@ -121,7 +125,7 @@ pub fn hull_manifold_or_separation(
         polyhedron_manifold_into(&pa, &pb, pose_ab, prediction, out);
         return None;
     }
-    polyhedron_manifold_or_separation(&pa, &pb, ca, cb, pose_ab, prediction, out)
+    manifold_or_separation_hinted(&pa, &pb, ca, cb, pose_ab, prediction, hint, out)
 }
 
 /// [`polyhedron_manifold_guided`], returning, when GJK finds the shapes farther apart than
@@ -140,23 +144,49 @@ pub fn polyhedron_manifold_or_separation(
     prediction: Real,
     out: &mut Vec<(Contact, FeatureId)>,
 ) -> Option<Separation> {
+    manifold_or_separation_hinted(a, b, ca, cb, pose_ab, prediction, None, out)
+}
+
+/// [`polyhedron_manifold_or_separation`] with GJK seeded by a guessed normal `hint` (A's
+/// frame, from A towards B; see [`hull_manifold_or_separation`]).
+#[allow(clippy::too_many_arguments)]
+fn manifold_or_separation_hinted(
+    a: &Polyhedron,
+    b: &Polyhedron,
+    ca: ConvexRef<'_>,
+    cb: ConvexRef<'_>,
+    pose_ab: &Isometry,
+    prediction: Real,
+    hint: Option<Vec3>,
+    out: &mut Vec<(Contact, FeatureId)>,
+) -> Option<Separation> {
     if let (ConvexRef::Cuboid(x), ConvexRef::Cuboid(y)) = (ca, cb) {
         cuboid_cuboid_manifold_into(x, y, a, b, pose_ab, prediction, out);
         return None;
     }
     let near = match (ca, cb) {
         (ConvexRef::Cuboid(x), ConvexRef::ConvexHull(h)) => {
-            large_box_hull(x, h, pose_ab, None, prediction, out)
+            large_box_hull(x, h, pose_ab, None, prediction, hint, out)
         }
         (ConvexRef::ConvexHull(h), ConvexRef::Cuboid(x)) => {
-            large_box_hull(x, h, &pose_ab.inverse(), Some(pose_ab), prediction, out)
+            // The hint turned into the box's frame, from the box towards the hull.
+            let hint = hint.map(|n| -pose_ab.transform_vector(n));
+            large_box_hull(
+                x,
+                h,
+                &pose_ab.inverse(),
+                Some(pose_ab),
+                prediction,
+                hint,
+                out,
+            )
         }
         _ => false,
     };
     if near {
         return None;
     }
-    guided_general(a, b, ca, cb, pose_ab, prediction, out)
+    guided_general(a, b, ca, cb, pose_ab, prediction, hint, out)
 }
 
 /// The separation of `ca` and `cb` (B at `pose_ab`) along `axis` (A's frame, from A towards
@@ -207,14 +237,17 @@ pub const LARGE_BOX_RATIO: Real = 4.0;
 /// and Jolt's clipping of large triangle meshes and heightfields to the query box.)
 ///
 /// `swap_back` is the caller's `pose_ab` when the hull was its A (the contacts are turned
-/// back into the hull's frame, hull first). Returns false (nothing written) when the box is
+/// back into the hull's frame, hull first). `hint` seeds GJK (a guessed normal in the box's
+/// frame, from the box towards the hull). Returns false (nothing written) when the box is
 /// not large against the hull, or the cut box would be degenerate.
+#[allow(clippy::too_many_arguments)]
 fn large_box_hull(
     x: &Cuboid,
     h: &ConvexHull,
     pose_xh: &Isometry,
     swap_back: Option<&Isometry>,
     prediction: Real,
+    hint: Option<Vec3>,
     out: &mut Vec<(Contact, FeatureId)>,
 ) -> bool {
     let he = x.half_extents();
@@ -251,6 +284,7 @@ fn large_box_hull(
         ConvexRef::ConvexHull(h),
         &pose_ch,
         prediction,
+        hint,
         out,
     );
     for (k, _) in &mut out[start..] {
@@ -265,7 +299,9 @@ fn large_box_hull(
 
 /// The guided path for pairs other than box–box: GJK/EPA, the guard's check, then clipping;
 /// a separation certificate when GJK finds the shapes apart (see
-/// [`polyhedron_manifold_or_separation`]).
+/// [`polyhedron_manifold_or_separation`]). `hint` seeds GJK (see
+/// [`contact_gjk_epa_unguarded_hinted`]).
+#[allow(clippy::too_many_arguments)]
 fn guided_general(
     a: &Polyhedron,
     b: &Polyhedron,
@@ -273,13 +309,14 @@ fn guided_general(
     cb: ConvexRef<'_>,
     pose_ab: &Isometry,
     prediction: Real,
+    hint: Option<Vec3>,
     out: &mut Vec<(Contact, FeatureId)>,
 ) -> Option<Separation> {
     // GJK/EPA unguarded, then the guard's one check: the shapes' exact separation along the
     // returned normal must be the returned distance; when it is not (EPA on a degenerate
     // polytope, e.g. shapes touching within round-off), the full separating-axis test runs
     // instead (the guard's own fallback for polyhedra, here giving the whole manifold).
-    let c = match contact_gjk_epa_unguarded_axis(ca, cb, pose_ab, prediction) {
+    let c = match contact_gjk_epa_unguarded_hinted(ca, cb, pose_ab, prediction, hint) {
         (GjkEpa::Beyond, axis) => return separation_along(ca, cb, pose_ab, axis, prediction),
         (GjkEpa::Separated(c) | GjkEpa::Penetrating(c), _) => c,
     };
