@@ -233,7 +233,13 @@ fn initial_tetrahedron<A: Support, B: Support>(
     for t in [[0, 1, 2], [0, 1, 3], [0, 2, 3], [1, 2, 3]] {
         let mut f = make_face(verts, t, tol)?;
         if f.normal.dot(centroid - verts[t[0] as usize].w) > 0.0 {
-            f = make_face(verts, [t[0], t[2], t[1]], tol)?;
+            // The reversed triangle: `make_face(verts, [t[0], t[2], t[1]], tol)` would give
+            // the cross product's exact negation (each product is the same, the difference
+            // changes sign), the same length and edges, so the negated normal and distance
+            // bit for bit, without computing them again.
+            f.idx = [t[0], t[2], t[1]];
+            f.normal = -f.normal;
+            f.dist = -f.dist;
         }
         faces.push(f);
     }

@@ -56,14 +56,25 @@ impl Simplex {
     /// Reduces to the support set of the closest point and returns that point.
     fn solve(&mut self) -> Vec3 {
         let sol = closest_to_origin(&self.w[..self.len]);
-        let mut out = Simplex::default();
+        // Compacted in place (the kept points keep their order; slot `k <= i`), instead of
+        // building a fresh simplex and copying it over this one.
+        let mut k = 0;
         for i in 0..self.len {
             if sol.mask & (1 << i) != 0 {
-                out.push(self.w[i], self.a[i], self.b[i]);
-                out.lambda[out.len - 1] = sol.lambda[i];
+                self.w[k] = self.w[i];
+                self.a[k] = self.a[i];
+                self.b[k] = self.b[i];
+                self.lambda[k] = sol.lambda[i];
+                k += 1;
             }
         }
-        *self = out;
+        for i in k..self.len {
+            self.w[i] = Vec3::ZERO;
+            self.a[i] = Vec3::ZERO;
+            self.b[i] = Vec3::ZERO;
+            self.lambda[i] = 0.0;
+        }
+        self.len = k;
         self.closest()
     }
 
