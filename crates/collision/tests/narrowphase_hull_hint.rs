@@ -40,7 +40,9 @@ fn manifold(
     let pose_ab = pose_a.inv_mul(pose_b);
     let mut out = Vec::new();
     hull_manifold_or_separation(a, b, &pose_ab, prediction, hint, &mut out);
-    out.into_iter().map(|(c, _)| c.transformed(pose_a)).collect()
+    out.into_iter()
+        .map(|(c, _)| c.transformed(pose_a))
+        .collect()
 }
 
 fn deepest(cs: &[Contact]) -> Option<Real> {
@@ -125,7 +127,11 @@ fn apart_pairs_have_no_point_whatever_the_seed() {
     let taru = Shape::ConvexHull(ConvexHull::new(&taru_points()).unwrap());
     let mut rng = Rng::new(9);
     for k in 0..200 {
-        let far = if k % 2 == 0 { Vec3::ZERO } else { Vec3::new(1.0e3, -2.0e2, 7.0e2) };
+        let far = if k % 2 == 0 {
+            Vec3::ZERO
+        } else {
+            Vec3::new(1.0e3, -2.0e2, 7.0e2)
+        };
         let rot = Quat::from_axis_angle(rng.unit(), rng.range(-3.0, 3.0));
         let dir = rng.unit();
         // The Taru hull's radius is under 2.7: 5.5 apart leaves a gap.
@@ -151,7 +157,11 @@ fn taru_stacks_give_the_same_depth_for_every_seed() {
     let bottom = h.vertices().iter().map(|v| v.y).fold(Real::MAX, Real::min);
     let mut rng = Rng::new(4);
     for k in 0..120 {
-        let far = if k % 2 == 0 { Vec3::ZERO } else { Vec3::new(-6.0e2, 3.0e2, 8.0e2) };
+        let far = if k % 2 == 0 {
+            Vec3::ZERO
+        } else {
+            Vec3::new(-6.0e2, 3.0e2, 8.0e2)
+        };
         let depth = [0.0, 1.0e-3, 1.0e-5][k % 3];
         let tilt = Quat::from_axis_angle(rng.unit(), rng.range(0.0, 2.0e-3));
         let spin = Quat::from_rotation_y(rng.range(-3.2, 3.2));
@@ -175,7 +185,15 @@ fn taru_stacks_give_the_same_depth_for_every_seed() {
                 assert!(c.normal.is_finite() && c.distance.is_finite(), "{c:?}");
             }
         }
-        check_against_polytope(&taru, &pose_a, &taru, &pose_b, &base, Kind::Random, tol + 0.02)
-            .unwrap_or_else(|e| panic!("case {k}: {e}"));
+        check_against_polytope(
+            &taru,
+            &pose_a,
+            &taru,
+            &pose_b,
+            &base,
+            Kind::Random,
+            tol + 0.02,
+        )
+        .unwrap_or_else(|e| panic!("case {k}: {e}"));
     }
 }
