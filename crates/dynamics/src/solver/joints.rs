@@ -29,6 +29,11 @@ pub(crate) struct JointScratch {
     pub joints: Vec<JointRows>,
     pub rows: Vec<Row>,
     pub blocks: Vec<Block>,
+    /// Per row (parallel to `rows`): the soft step's impulse summed over the substeps so
+    /// far — each substep's accumulated impulse after its last pass (the relax), i.e. the
+    /// impulse the row applied in that substep. Breaking compares the step's sum, not the
+    /// last substep's impulse scaled up (a load that peaks in an early substep counts).
+    pub sums: Vec<Real>,
     /// Colour ranges into `joints`; the last one is the overflow colour (possibly empty),
     /// whose joints may share bodies.
     pub colours: Vec<Range<usize>>,
@@ -91,6 +96,8 @@ pub(crate) fn prepare(
         }
         s.colours.push(start..s.joints.len());
     }
+    s.sums.clear();
+    s.sums.resize(s.rows.len(), 0.0);
 }
 
 impl JointScratch {
@@ -206,6 +213,8 @@ pub(crate) struct JointView {
     n_rows: usize,
     blocks: *mut Block,
     n_blocks: usize,
+    /// [`JointScratch::sums`] (as long as the rows).
+    sums: *mut Real,
 }
 
 impl JointView {
@@ -218,6 +227,10 @@ impl JointView {
             n_rows: s.rows.len(),
             blocks: s.blocks.as_mut_ptr(),
             n_blocks: s.blocks.len(),
+            sums: {
+                assert_eq!(s.sums.len(), s.rows.len());
+                s.sums.as_mut_ptr()
+            },
         }
     }
 
@@ -265,6 +278,13 @@ impl JointView {
                         refresh_own(jr, j, set, &*pa, &*pb, own, own_blocks);
                     }
                     solve_joint(own, own_blocks, &mut a, &mut b, soft, inv_h, false);
+                    // The relax is the substep's last joint pass: its impulses are the
+                    // substep's.
+                    let sums =
+                        std::slice::from_raw_parts_mut(self.sums.add(rows.start), rows.len());
+                    for (sum, row) in sums.iter_mut().zip(own.iter()) {
+                        *sum += row.impulse;
+                    }
                 }
             }
             // Only dynamic bodies are written (a shared static body is only read), through
@@ -279,14 +299,26 @@ impl JointView {
     }
 }
 
-/// Stores the impulses (scaled to per-step units) for warm starting and breaking.
-pub(crate) fn store(s: &JointScratch, joints: &mut JointSet, scale: Real) {
+/// Stores the impulses (scaled to per-step units) for warm starting, and each joint's
+/// peak row impulse of the step for breaking: with `summed` (the soft step) the sum of
+/// the row's substep impulses ([`JointScratch::sums`]), else the stored impulse (sequential
+/// impulses: one step, no substeps).
+pub(crate) fn store(s: &JointScratch, joints: &mut JointSet, scale: Real, summed: bool) {
     for jr in &s.joints {
         if let Some(j) = joints.get_index_mut(jr.joint) {
             j.impulses = [0.0; ROW_SLOTS];
-            for row in &s.rows[jr.rows.clone()] {
-                j.impulses[row.slot as usize] = row.impulse * scale;
+            let mut peak: Real = 0.0;
+            for (k, row) in s.rows[jr.rows.clone()].iter().enumerate() {
+                let stored = row.impulse * scale;
+                j.impulses[row.slot as usize] = stored;
+                let step = if summed {
+                    s.sums[jr.rows.start + k]
+                } else {
+                    stored
+                };
+                peak = peak.max(step.abs());
             }
+            j.step_peak = peak;
         }
     }
 }

@@ -77,7 +77,7 @@ pub(crate) fn step(ctx: &mut StepContext) {
     lap(&mut t, &mut ctx.timings.integrate);
 
     contact::store(cons, ctx.manifolds, 1.0);
-    joints::store(rows, ctx.joints, 1.0);
+    joints::store(rows, ctx.joints, 1.0, false);
     integrate::store(ctx.set, ctx.bodies);
     lap(&mut t, &mut ctx.timings.store);
 }

@@ -128,7 +128,7 @@ pub(crate) fn step(ctx: &mut StepContext) {
     // The wide constraints' impulses, the velocities and the world inertias were stored by
     // the last stages; what is left is serial and small.
     contact::store(&scratch.cons, ctx.manifolds, n as Real);
-    joints::store(rows, ctx.joints, n as Real);
+    joints::store(rows, ctx.joints, n as Real, true);
     integrate::clear_forces(ctx.set, ctx.bodies.len());
     lap(&mut t, &mut ctx.timings.store);
 }
