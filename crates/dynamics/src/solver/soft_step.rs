@@ -58,7 +58,8 @@ pub(crate) fn step(ctx: &mut StepContext) {
         scratch,
     );
     let rows = &mut *ctx.joint_scratch;
-    joints::prepare(rows, ctx.joints, ctx.set, ctx.bodies, h, warm);
+    // The effective masses are left to the first joint pass (parallel blocks).
+    joints::prepare(rows, ctx.joints, ctx.set, ctx.bodies, h, warm, false);
 
     let plan = &mut ctx.scratch.stages;
     let colours = if simd {
@@ -112,7 +113,7 @@ pub(crate) fn step(ctx: &mut StepContext) {
             SoftStage::IntegrateVelocities => &mut ctx.timings.forces,
             SoftStage::IntegratePositions => &mut ctx.timings.integrate,
             SoftStage::StoreBodies | SoftStage::StoreImpulses => &mut ctx.timings.store,
-            SoftStage::Joints(pass, _)
+            SoftStage::Joints(pass, _, _)
             | SoftStage::Colour(pass, _)
             | SoftStage::Serial(pass, _, _) => match pass {
                 Pass::WarmStart => &mut ctx.timings.warm_start,
