@@ -281,8 +281,8 @@ impl DynamicsWorld {
         let t = Instant::now();
         // (The solvers stored the velocities and world inertias and cleared the forces.)
         for (jh, j) in self.joints.iter_mut() {
-            let peak = j.impulses.iter().fold(0.0 as Real, |m, x| m.max(x.abs()));
-            if !j.broken && peak > j.desc.break_impulse {
+            // The peak of the step's impulse, summed over its substeps (`joints::store`).
+            if !j.broken && j.step_peak > j.desc.break_impulse {
                 j.broken = true;
                 report.broken_joints.push(jh);
             }

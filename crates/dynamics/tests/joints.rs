@@ -348,3 +348,69 @@ fn ragdoll_from_the_scene_comes_to_rest() {
         }
     }
 }
+
+/// A joint loaded in one step, just above or below its `break_impulse`: a ball moving at
+/// `v` is stopped by a ball joint at its centre (no gravity), so the joint's impulse over
+/// the first step is `m v`, nearly all of it in the first substep. Breaking used to look at
+/// the last substep's impulse scaled to the step, which missed such a load (the soft step
+/// held at a tenth of `m v`); it now compares the impulse summed over the substeps.
+#[test]
+fn joint_breaks_on_the_impulse_of_the_whole_step() {
+    for kind in KINDS {
+        for (factor, breaks) in [(0.1, true), (0.9, true), (1.1, false), (2.0, false)] {
+            let mut w = world(kind, Vec3::ZERO);
+            let base = anchor(&mut w, Vec3::new(0.0, 5.0, 0.0));
+            let b = ball(&mut w, Vec3::new(0.0, 5.0, 0.0), 0.2);
+            let v: Real = 3.0;
+            w.bodies_mut()
+                .set_linear_velocity(b, Vec3::new(v, 0.0, 0.0))
+                .unwrap();
+            let m = 1.0 / w.bodies().inv_mass(b).unwrap();
+            let mut desc = JointDesc::new(
+                base,
+                b,
+                Isometry::IDENTITY,
+                Isometry::IDENTITY,
+                JointKind::Ball,
+            );
+            desc.break_impulse = factor * m * v;
+            let h = w.create_joint(&desc).unwrap();
+            let mut broken = Vec::new();
+            for step in 0..30 {
+                let report = w.step(1.0 / 60.0, &mut []).unwrap();
+                broken.extend(report.broken_joints.iter().map(|&j| (step, j)));
+            }
+            // It breaks at the end of the step that stopped the ball (the step's impulse
+            // was applied), or never.
+            let expected = if breaks { vec![(0, h)] } else { vec![] };
+            assert_eq!(broken, expected, "{kind:?}, break at {factor} m v");
+            let speed = w.bodies().linear_velocity(b).unwrap().length();
+            assert!(speed < 0.05 * v, "{kind:?}: ball still at {speed}");
+        }
+    }
+}
+
+/// A weight hanging from a ball joint: holds when the break impulse is just above its
+/// weight's impulse per step, breaks just below (a steady load, the same on every substep).
+#[test]
+fn joint_under_a_steady_load_breaks_just_above_its_threshold() {
+    let g: Real = 9.81;
+    for kind in KINDS {
+        for (factor, breaks) in [(0.95, true), (1.05, false)] {
+            let mut w = world(kind, Vec3::new(0.0, -g, 0.0));
+            let base = anchor(&mut w, Vec3::new(0.0, 5.0, 0.0));
+            let b = ball(&mut w, Vec3::new(0.0, 4.0, 0.0), 0.2);
+            let m = 1.0 / w.bodies().inv_mass(b).unwrap();
+            let fb = Isometry::from_translation(Vec3::new(0.0, 1.0, 0.0));
+            let mut desc = JointDesc::new(base, b, Isometry::IDENTITY, fb, JointKind::Ball);
+            desc.break_impulse = factor * m * g / 60.0;
+            let h = w.create_joint(&desc).unwrap();
+            let mut broken = Vec::new();
+            for _ in 0..60 {
+                broken.extend(w.step(1.0 / 60.0, &mut []).unwrap().broken_joints);
+            }
+            let expected = if breaks { vec![h] } else { vec![] };
+            assert_eq!(broken, expected, "{kind:?}, break at {factor} m g dt");
+        }
+    }
+}

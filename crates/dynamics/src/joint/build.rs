@@ -43,6 +43,9 @@ pub(crate) struct JointRows {
     pub rows: Range<usize>,
     /// The joint's blocks in the shared block buffer (`start` relative to `rows.start`).
     pub blocks: Range<usize>,
+    /// The joint has a finite `break_impulse`: only then does the soft step sum its rows'
+    /// substep impulses for breaking.
+    pub breakable: bool,
     /// Anchor of frame A relative to A's centre of mass, in A's body axes (box3d's
     /// `frameA.p = rot(q, f.p - localCenter)` before the rotation).
     local_a: Vec3,
@@ -93,7 +96,8 @@ impl JointRows {
 /// Builds the rows of `joint` (slot `index`) for a step with substep `h` (for motor force
 /// bounds and spring softness), appending them to `rows` and its blocks to `blocks`;
 /// stored impulses are scaled by `impulse_in`. Returns `None` (and appends nothing) for
-/// broken joints or joints between non-moving bodies.
+/// broken joints or joints between non-moving bodies. The effective masses are computed
+/// only with `with_masses` (else [`masses_own`] must run before the rows are used).
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn prepare_joint(
     index: usize,
@@ -104,6 +108,7 @@ pub(crate) fn prepare_joint(
     impulse_in: Real,
     rows: &mut Vec<Row>,
     blocks: &mut Vec<Block>,
+    with_masses: bool,
 ) -> Option<JointRows> {
     let desc = &joint.desc;
     let (a, b) = (desc.body_a.index as usize, desc.body_b.index as usize);
@@ -114,6 +119,7 @@ pub(crate) fn prepare_joint(
     let block_start = blocks.len();
     let mut jr = JointRows {
         joint: index,
+        breakable: desc.break_impulse.is_finite(),
         a,
         b,
         rows: row_start..row_start,
@@ -145,7 +151,9 @@ pub(crate) fn prepare_joint(
         }
     }
     jr.blocks = block_start..blocks.len();
-    masses(&jr, rows, blocks, bodies);
+    if with_masses {
+        masses(&jr, rows, blocks, bodies);
+    }
     Some(jr)
 }
 
@@ -209,9 +217,10 @@ fn masses(jr: &JointRows, rows: &mut [Row], blocks: &mut [Block], bodies: &[Solv
     );
 }
 
-/// [`masses`] on one joint's own rows and blocks.
+/// [`masses`] on one joint's own rows and blocks (`own`, `blocks`: the joint's ranges of
+/// the shared buffers) with its bodies `sa`, `sb`.
 #[inline]
-fn masses_own(own: &mut [Row], blocks: &mut [Block], sa: &SolverBody, sb: &SolverBody) {
+pub(crate) fn masses_own(own: &mut [Row], blocks: &mut [Block], sa: &SolverBody, sb: &SolverBody) {
     let p = PairInertia::of(sa, sb);
     let mut i = 0;
     for block in blocks {

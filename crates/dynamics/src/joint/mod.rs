@@ -14,7 +14,7 @@ mod scene;
 #[cfg(test)]
 mod tests;
 
-pub(crate) use build::{prepare_joint, refresh_own, JointRows, ROW_SLOTS};
+pub(crate) use build::{masses_own, prepare_joint, refresh_own, JointRows, ROW_SLOTS};
 
 use crate::body_set::BodyHandle;
 use carom_collision::math::{check_finite, check_isometry, check_non_negative, Isometry, Real};
@@ -244,8 +244,13 @@ pub struct Joint {
     pub desc: JointDesc,
     /// True once broken; a broken joint no longer acts.
     pub broken: bool,
-    /// Accumulated impulses per row slot (per step, for warm starting and breaking).
+    /// Accumulated impulses per row slot (per step, for warm starting).
     pub(crate) impulses: [Real; ROW_SLOTS],
+    /// The largest magnitude of one row's impulse over the last step (N·s), summed over
+    /// the substeps of the soft step: what breaking compares with `break_impulse`. Derived
+    /// by the solver each step (not serialised).
+    #[serde(skip)]
+    pub(crate) step_peak: Real,
 }
 
 /// All joints of a world.
@@ -262,6 +267,7 @@ impl JointSet {
             desc,
             broken: false,
             impulses: [0.0; ROW_SLOTS],
+            step_peak: 0.0,
         };
         let index = match self.free.pop() {
             Some(i) => i as usize,

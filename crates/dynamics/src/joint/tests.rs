@@ -122,6 +122,7 @@ fn prepare(r: &Rig, bodies: &[SolverBody]) -> (JointRows, Vec<Row>, Vec<Block>) 
         0.25,
         &mut rows,
         &mut blocks,
+        true,
     );
     (jr.unwrap(), rows, blocks)
 }

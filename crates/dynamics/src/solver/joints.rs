@@ -18,7 +18,7 @@ use super::coloring::{colour_into, ColourScratch, Colouring};
 use super::rows::{Block, Motion, Row};
 use super::{Softness, SolverBody};
 use crate::body_set::BodySet;
-use crate::joint::{prepare_joint, refresh_own, JointRows, JointSet, ROW_SLOTS};
+use crate::joint::{masses_own, prepare_joint, refresh_own, JointRows, JointSet, ROW_SLOTS};
 use carom_collision::math::{Real, Vec3};
 use std::ops::Range;
 
@@ -29,6 +29,12 @@ pub(crate) struct JointScratch {
     pub joints: Vec<JointRows>,
     pub rows: Vec<Row>,
     pub blocks: Vec<Block>,
+    /// Per row (parallel to `rows`): the soft step's impulse summed over the substeps so
+    /// far — each substep's accumulated impulse after its last pass (the relax), i.e. the
+    /// impulse the row applied in that substep. Breaking compares the step's sum, not the
+    /// last substep's impulse scaled up (a load that peaks in an early substep counts).
+    /// Summed only for breakable joints (zero for the others: breaking never reads them).
+    pub sums: Vec<Real>,
     /// Colour ranges into `joints`; the last one is the overflow colour (possibly empty),
     /// whose joints may share bodies.
     pub colours: Vec<Range<usize>>,
@@ -45,7 +51,11 @@ pub(crate) struct JointScratch {
 /// Builds the rows of every active joint for a step with substep `h` (the whole step for
 /// sequential impulses); `impulse_in` converts stored per-step impulses to the solver's
 /// units. The joints are coloured first and built colour by colour, so the rows of a colour
-/// are contiguous and in the order the passes read them.
+/// are contiguous and in the order the passes read them. Without `masses` the rows' effective
+/// masses and inertia-weighted Jacobians are left unset: the soft step computes them in its
+/// first joint pass ([`JointView::run`] with `first`), in the colours' parallel blocks
+/// rather than here, serially (about a third of this function's instructions on the
+/// ragdoll scene).
 pub(crate) fn prepare(
     s: &mut JointScratch,
     joints: &JointSet,
@@ -53,6 +63,7 @@ pub(crate) fn prepare(
     bodies: &[SolverBody],
     h: Real,
     impulse_in: Real,
+    masses: bool,
 ) {
     s.joints.clear();
     s.rows.clear();
@@ -85,12 +96,15 @@ pub(crate) fn prepare(
                 continue;
             };
             let (rows, blocks) = (&mut s.rows, &mut s.blocks);
-            if let Some(jr) = prepare_joint(index, j, set, bodies, h, impulse_in, rows, blocks) {
+            let jr = prepare_joint(index, j, set, bodies, h, impulse_in, rows, blocks, masses);
+            if let Some(jr) = jr {
                 s.joints.push(jr);
             }
         }
         s.colours.push(start..s.joints.len());
     }
+    s.sums.clear();
+    s.sums.resize(s.rows.len(), 0.0);
 }
 
 impl JointScratch {
@@ -206,6 +220,8 @@ pub(crate) struct JointView {
     n_rows: usize,
     blocks: *mut Block,
     n_blocks: usize,
+    /// [`JointScratch::sums`] (as long as the rows).
+    sums: *mut Real,
 }
 
 impl JointView {
@@ -218,12 +234,17 @@ impl JointView {
             n_rows: s.rows.len(),
             blocks: s.blocks.as_mut_ptr(),
             n_blocks: s.blocks.len(),
+            sums: {
+                assert_eq!(s.sums.len(), s.rows.len());
+                s.sums.as_mut_ptr()
+            },
         }
     }
 
     /// Runs `pass` on the joints `range` (indices into the scratch's joint list), one after
     /// another: each reads its bodies' velocities, updates them through its rows and writes
-    /// them back to the dynamic ones.
+    /// them back to the dynamic ones. With `first` (the step's first joint pass after a
+    /// [`prepare`] without masses) each joint first computes its rows' effective masses.
     ///
     /// # Safety
     /// The scratch behind `self` is alive and unchanged; `bodies` points to `n_bodies`
@@ -235,6 +256,7 @@ impl JointView {
         &self,
         range: Range<usize>,
         pass: JointPass,
+        first: bool,
         bodies: *mut SolverBody,
         n_bodies: usize,
         set: &BodySet,
@@ -253,6 +275,9 @@ impl JointView {
             let own_blocks =
                 std::slice::from_raw_parts_mut(self.blocks.add(blocks.start), blocks.len());
             let (pa, pb) = (bodies.add(jr.a), bodies.add(jr.b));
+            if first {
+                masses_own(own, own_blocks, &*pa, &*pb);
+            }
             let (mut a, mut b) = (Motion::of(&*pa), Motion::of(&*pb));
             match pass {
                 JointPass::WarmStart => warm_start_joint(own, &mut a, &mut b),
@@ -265,6 +290,15 @@ impl JointView {
                         refresh_own(jr, j, set, &*pa, &*pb, own, own_blocks);
                     }
                     solve_joint(own, own_blocks, &mut a, &mut b, soft, inv_h, false);
+                    // The relax is the substep's last joint pass: its impulses are the
+                    // substep's (summed only where breaking reads them).
+                    if jr.breakable {
+                        let sums =
+                            std::slice::from_raw_parts_mut(self.sums.add(rows.start), rows.len());
+                        for (sum, row) in sums.iter_mut().zip(own.iter()) {
+                            *sum += row.impulse;
+                        }
+                    }
                 }
             }
             // Only dynamic bodies are written (a shared static body is only read), through
@@ -279,14 +313,27 @@ impl JointView {
     }
 }
 
-/// Stores the impulses (scaled to per-step units) for warm starting and breaking.
-pub(crate) fn store(s: &JointScratch, joints: &mut JointSet, scale: Real) {
+/// Stores the impulses (scaled to per-step units) for warm starting, and each joint's
+/// peak row impulse of the step for breaking: with `summed` (the soft step) the sum of
+/// the row's substep impulses ([`JointScratch::sums`]) of a breakable joint, else the
+/// stored impulse (sequential impulses: one step, no substeps; an unbreakable joint, which
+/// never breaks).
+pub(crate) fn store(s: &JointScratch, joints: &mut JointSet, scale: Real, summed: bool) {
     for jr in &s.joints {
         if let Some(j) = joints.get_index_mut(jr.joint) {
             j.impulses = [0.0; ROW_SLOTS];
-            for row in &s.rows[jr.rows.clone()] {
-                j.impulses[row.slot as usize] = row.impulse * scale;
+            let mut peak: Real = 0.0;
+            for (k, row) in s.rows[jr.rows.clone()].iter().enumerate() {
+                let stored = row.impulse * scale;
+                j.impulses[row.slot as usize] = stored;
+                let step = if summed && jr.breakable {
+                    s.sums[jr.rows.start + k]
+                } else {
+                    stored
+                };
+                peak = peak.max(step.abs());
             }
+            j.step_peak = peak;
         }
     }
 }

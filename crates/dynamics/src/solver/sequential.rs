@@ -38,7 +38,7 @@ pub(crate) fn step(ctx: &mut StepContext) {
     );
     let (cons, ranges) = (&mut scratch.cons, &scratch.colouring.ranges[..]);
     let rows = &mut *ctx.joint_scratch;
-    joints::prepare(rows, ctx.joints, ctx.set, ctx.bodies, dt, warm);
+    joints::prepare(rows, ctx.joints, ctx.set, ctx.bodies, dt, warm, true);
     rows.order_by_slot();
     lap(&mut t, &mut ctx.timings.prepare);
 
@@ -77,7 +77,7 @@ pub(crate) fn step(ctx: &mut StepContext) {
     lap(&mut t, &mut ctx.timings.integrate);
 
     contact::store(cons, ctx.manifolds, 1.0);
-    joints::store(rows, ctx.joints, 1.0);
+    joints::store(rows, ctx.joints, 1.0, false);
     integrate::store(ctx.set, ctx.bodies);
     lap(&mut t, &mut ctx.timings.store);
 }

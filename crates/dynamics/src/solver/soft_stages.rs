@@ -64,8 +64,11 @@ pub(crate) enum SoftStage {
     /// Gravity, forces, damping and the gyroscopic term, in blocks of bodies.
     IntegrateVelocities,
     /// Joint colour `k` (an index into the joint colour ranges, the last one the joint
-    /// overflow colour, which is one block), in blocks of joints.
-    Joints(Pass, u8),
+    /// overflow colour, which is one block), in blocks of joints. The flag marks the step's
+    /// first joint pass, which first computes the effective masses of the joints' rows
+    /// (left out of the serial `joints::prepare`, so they are computed in the colour's
+    /// parallel blocks).
+    Joints(Pass, u8, bool),
     /// Colour `k` (an index into the colour ranges), in blocks of constraints.
     Colour(Pass, u8),
     /// Contact colours `lo..hi` one after another in one block, index `colours.len()` being
@@ -136,13 +139,13 @@ impl Shape<'_> {
         }
     }
 
-    /// The contact and joint stages of one pass.
-    fn pass(&self, list: &mut StageList<SoftStage>, pass: Pass) {
+    /// The contact and joint stages of one pass; `first` marks the step's first joint pass.
+    fn pass(&self, list: &mut StageList<SoftStage>, pass: Pass, first: bool) {
         if pass != Pass::Restitution {
             for (k, r) in self.joint_colours.iter().enumerate() {
                 let blocks = self.joint_blocks(k, r);
                 let k = u8::try_from(k).unwrap_or(u8::MAX);
-                list.push(SoftStage::Joints(pass, k), blocks);
+                list.push(SoftStage::Joints(pass, k, first), blocks);
             }
         }
         let byte = |k: usize| u8::try_from(k).unwrap_or(u8::MAX);
@@ -179,16 +182,16 @@ impl Shape<'_> {
 pub(crate) fn plan(list: &mut StageList<SoftStage>, s: &Shape) {
     list.clear();
     let body_blocks = block_count(s.bodies, BODY_BLOCK);
-    for _ in 0..s.substeps {
+    for i in 0..s.substeps {
         list.push(SoftStage::IntegrateVelocities, body_blocks);
         if s.warm_starting {
-            s.pass(list, Pass::WarmStart);
+            s.pass(list, Pass::WarmStart, i == 0);
         }
-        s.pass(list, Pass::Solve);
+        s.pass(list, Pass::Solve, i == 0 && !s.warm_starting);
         list.push(SoftStage::IntegratePositions, body_blocks);
-        s.pass(list, Pass::Relax);
+        s.pass(list, Pass::Relax, false);
     }
-    s.pass(list, Pass::Restitution);
+    s.pass(list, Pass::Restitution, false);
     list.push(SoftStage::StoreBodies, body_blocks);
     list.push(SoftStage::StoreImpulses, block_count(s.wide, STORE_BLOCK));
 }
@@ -353,7 +356,7 @@ impl Shared<'_> {
                 let (m, n) = (self.manifolds, self.n_manifolds);
                 contact_simd::store_range(self.wide, b, m, n, c.impulse_scale);
             }
-            SoftStage::Joints(pass, k) => {
+            SoftStage::Joints(pass, k, first) => {
                 let pass = match pass {
                     Pass::WarmStart => JointPass::WarmStart,
                     Pass::Solve => JointPass::Solve,
@@ -366,7 +369,7 @@ impl Shared<'_> {
                 let (soft, inv_h, set) = (c.joint_soft, c.inv_h, &*self.set);
                 let (bodies, n) = (self.bodies, self.n_bodies);
                 self.rows
-                    .run(range, pass, bodies, n, set, self.joints, soft, inv_h);
+                    .run(range, pass, first, bodies, n, set, self.joints, soft, inv_h);
             }
             SoftStage::Colour(pass, k) => {
                 let r = &self.colours[k as usize];

@@ -58,7 +58,8 @@ pub(crate) fn step(ctx: &mut StepContext) {
         scratch,
     );
     let rows = &mut *ctx.joint_scratch;
-    joints::prepare(rows, ctx.joints, ctx.set, ctx.bodies, h, warm);
+    // The effective masses are left to the first joint pass (parallel blocks).
+    joints::prepare(rows, ctx.joints, ctx.set, ctx.bodies, h, warm, false);
 
     let plan = &mut ctx.scratch.stages;
     let colours = if simd {
@@ -112,7 +113,7 @@ pub(crate) fn step(ctx: &mut StepContext) {
             SoftStage::IntegrateVelocities => &mut ctx.timings.forces,
             SoftStage::IntegratePositions => &mut ctx.timings.integrate,
             SoftStage::StoreBodies | SoftStage::StoreImpulses => &mut ctx.timings.store,
-            SoftStage::Joints(pass, _)
+            SoftStage::Joints(pass, _, _)
             | SoftStage::Colour(pass, _)
             | SoftStage::Serial(pass, _, _) => match pass {
                 Pass::WarmStart => &mut ctx.timings.warm_start,
@@ -128,7 +129,7 @@ pub(crate) fn step(ctx: &mut StepContext) {
     // The wide constraints' impulses, the velocities and the world inertias were stored by
     // the last stages; what is left is serial and small.
     contact::store(&scratch.cons, ctx.manifolds, n as Real);
-    joints::store(rows, ctx.joints, n as Real);
+    joints::store(rows, ctx.joints, n as Real, true);
     integrate::clear_forces(ctx.set, ctx.bodies.len());
     lap(&mut t, &mut ctx.timings.store);
 }
