@@ -143,7 +143,8 @@ pub struct CollisionWorld {
     changes: WorldPairChanges,
     narrowphase: NarrowPhase<ObjectHandle>,
     timings: UpdateTimings,
-    /// Reused buffer of [`CollisionWorld::sync_objects`].
+    /// Reused buffer of [`CollisionWorld::sync_objects`] (its parallel passes).
+    #[cfg_attr(not(feature = "parallel"), allow(dead_code))]
     sync_scratch: Vec<Option<sync::Synced>>,
 }
 
