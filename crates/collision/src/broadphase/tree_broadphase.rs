@@ -11,7 +11,7 @@
 //! those whose exact boxes overlap.
 
 use super::pair_keys::sort_dedup_pair_keys;
-use super::tree_search::{Part, MOVED_CHUNK, PARALLEL_MIN_LEAVES};
+use super::tree_search::{merge_candidates, MergePart, Part, MOVED_CHUNK, PARALLEL_MIN_LEAVES};
 use super::{pair_key, unpack_pair, BroadPhase, Filter, InsertStrategy};
 use super::{PairCache, PairChanges, ProxyHandle, ProxyStore, TreeProxy};
 use crate::bvh::DynamicTree;
@@ -56,6 +56,10 @@ pub struct TreeBroadPhase {
     /// part is grown to them, so that tasks whose work shifts from update to update stop
     /// allocating once the largest has been seen.
     pub(super) part_capacity: [usize; 3],
+    /// Reused buffers of the parallel candidate merge ([`merge_candidates`]) and the
+    /// largest capacities they reached (surviving candidates, exact pairs).
+    merge_parts: Vec<MergePart>,
+    merge_capacity: [usize; 2],
     /// A proxy was removed since the last update (its candidate pairs must be dropped).
     removed_since_update: bool,
     /// Leaves re-inserted per update and tree by the incremental optimisation.
@@ -117,6 +121,8 @@ impl TreeBroadPhase {
             task_scratch: Vec::new(),
             parts: Vec::new(),
             part_capacity: [0; 3],
+            merge_parts: Vec::new(),
+            merge_capacity: [0; 2],
             removed_since_update: false,
             optimize_per_update: 4,
             full_sweep_fraction: 0.5,
@@ -373,35 +379,15 @@ impl BroadPhase for TreeBroadPhase {
             } else {
                 let mut next = std::mem::take(&mut self.next_candidates);
                 next.clear();
-                let old = &self.candidates;
-                let (mut i, mut j) = (0, 0);
-                while i < old.len() && j < new_keys.len() {
-                    let (o, n) = (old[i], new_keys[j]);
-                    let k = if o < n {
-                        // Only in the surviving candidates.
-                        i += 1;
-                        if !view.unchanged(o) {
-                            continue;
-                        }
-                        o
-                    } else {
-                        j += 1;
-                        i += (o == n) as usize;
-                        n
-                    };
-                    next.push(k);
-                    view.emit(k, &mut exact);
-                }
-                for &o in &old[i..] {
-                    if view.unchanged(o) {
-                        next.push(o);
-                        view.emit(o, &mut exact);
-                    }
-                }
-                for &n in &new_keys[j..] {
-                    next.push(n);
-                    view.emit(n, &mut exact);
-                }
+                merge_candidates(
+                    &view,
+                    &self.candidates,
+                    &new_keys,
+                    &mut next,
+                    &mut exact,
+                    &mut self.merge_parts,
+                    &mut self.merge_capacity,
+                );
                 self.next_candidates = std::mem::replace(&mut self.candidates, next);
             }
         }
@@ -438,7 +424,7 @@ impl BroadPhase for TreeBroadPhase {
 }
 
 /// What the candidate pass of [`TreeBroadPhase::update_pairs`] reads, per slot.
-struct PairView<'a> {
+pub(super) struct PairView<'a> {
     alive: &'a [bool],
     boxes: &'a [Aabb],
     filters: &'a [Filter],
@@ -450,7 +436,7 @@ impl PairView<'_> {
     /// True when a surviving candidate stays one without a test: neither proxy moved (so
     /// their fat boxes still overlap) nor was removed.
     #[inline(always)]
-    fn unchanged(&self, k: u64) -> bool {
+    pub(super) fn unchanged(&self, k: u64) -> bool {
         let (a, b) = unpack_pair(k);
         let (a, b) = (a as usize, b as usize);
         !(self.moved[a] || self.moved[b] || (self.removals && !(self.alive[a] && self.alive[b])))
@@ -458,7 +444,7 @@ impl PairView<'_> {
 
     /// Pushes candidate `k` to `exact` when the exact boxes overlap and the filters accept.
     #[inline(always)]
-    fn emit(&self, k: u64, exact: &mut Vec<u64>) {
+    pub(super) fn emit(&self, k: u64, exact: &mut Vec<u64>) {
         let (a, b) = unpack_pair(k);
         let (a, b) = (a as usize, b as usize);
         if self.boxes[a].intersects(&self.boxes[b]) && self.filters[a].can_pair(&self.filters[b]) {

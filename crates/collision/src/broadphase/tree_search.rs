@@ -5,7 +5,7 @@
 //! depend on the thread count.
 
 use super::pair_key;
-use super::tree_broadphase::{MOVING, RESTING};
+use super::tree_broadphase::{PairView, MOVING, RESTING};
 use super::TreeBroadPhase;
 
 impl TreeBroadPhase {
@@ -159,5 +159,144 @@ impl Part {
                 c[2].max(p.pair_stack.capacity()),
             ]
         })
+    }
+}
+
+/// Surviving candidates per chunk of the parallel candidate merge; the merge is split from
+/// two chunks up.
+#[cfg(feature = "parallel")]
+const MERGE_CHUNK: usize = 4096;
+
+/// One chunk's reused buffers in the parallel candidate merge.
+#[derive(Debug, Clone, Default)]
+#[cfg_attr(not(feature = "parallel"), allow(dead_code))]
+pub(super) struct MergePart {
+    next: Vec<u64>,
+    exact: Vec<u64>,
+}
+
+/// Merges the sorted surviving candidates `old` with the sorted, deduplicated new candidates
+/// `new` into `next`, dropping a surviving candidate that is not
+/// [`PairView::unchanged`] and not found again, and pushes the candidates whose exact boxes
+/// overlap and whose filters accept to `exact` ([`PairView::emit`]); both outputs sorted.
+///
+/// From two chunks of `MERGE_CHUNK` (4096) surviving candidates up and on more than one thread
+/// (with the `parallel` feature), `old` is cut at fixed
+/// positions and `new` at the first key of each chunk (a binary search), so each chunk
+/// holds every key of its key range; the chunks are merged in parallel with the `parallel`
+/// feature, each into its own reused buffers (`parts`), which are appended in chunk order:
+/// the output is the serial merge's, on any thread count. `capacity` keeps the largest
+/// buffer sizes seen, to which every part is grown (no allocation once the largest chunk
+/// has been seen).
+pub(super) fn merge_candidates(
+    view: &PairView<'_>,
+    old: &[u64],
+    new: &[u64],
+    next: &mut Vec<u64>,
+    exact: &mut Vec<u64>,
+    parts: &mut Vec<MergePart>,
+    capacity: &mut [usize; 2],
+) {
+    #[cfg(feature = "parallel")]
+    if old.len() > MERGE_CHUNK && rayon::current_num_threads() > 1 {
+        merge_split(view, old, new, next, exact, parts, capacity);
+        return;
+    }
+    #[cfg(not(feature = "parallel"))]
+    let _ = (parts, capacity);
+    merge_range(view, old, new, next, exact);
+}
+
+/// The split merge of [`merge_candidates`].
+#[cfg(feature = "parallel")]
+fn merge_split(
+    view: &PairView<'_>,
+    old: &[u64],
+    new: &[u64],
+    next: &mut Vec<u64>,
+    exact: &mut Vec<u64>,
+    parts: &mut Vec<MergePart>,
+    capacity: &mut [usize; 2],
+) {
+    use rayon::prelude::*;
+    let chunks = old.len().div_ceil(MERGE_CHUNK);
+    if parts.len() < chunks {
+        parts.resize_with(chunks, MergePart::default);
+    }
+    // The start of chunk `c` in `new`: its first key not below the chunk's first key.
+    let new_start = |c: usize| -> usize {
+        if c == 0 {
+            0
+        } else if c == chunks {
+            new.len()
+        } else {
+            new.partition_point(|&k| k < old[c * MERGE_CHUNK])
+        }
+    };
+    let cap = *capacity;
+    let run = |c: usize, part: &mut MergePart| {
+        part.next.clear();
+        part.exact.clear();
+        part.next.reserve(cap[0]);
+        part.exact.reserve(cap[1]);
+        let lo = c * MERGE_CHUNK;
+        let hi = (lo + MERGE_CHUNK).min(old.len());
+        let (nlo, nhi) = (new_start(c), new_start(c + 1));
+        merge_range(
+            view,
+            &old[lo..hi],
+            &new[nlo..nhi],
+            &mut part.next,
+            &mut part.exact,
+        );
+    };
+    parts[..chunks]
+        .par_iter_mut()
+        .enumerate()
+        .with_max_len(1)
+        .for_each(|(c, part)| run(c, part));
+    for p in &parts[..chunks] {
+        next.extend_from_slice(&p.next);
+        exact.extend_from_slice(&p.exact);
+        capacity[0] = capacity[0].max(p.next.capacity());
+        capacity[1] = capacity[1].max(p.exact.capacity());
+    }
+}
+
+/// The serial merge of [`merge_candidates`] over one key range.
+fn merge_range(
+    view: &PairView<'_>,
+    old: &[u64],
+    new: &[u64],
+    next: &mut Vec<u64>,
+    exact: &mut Vec<u64>,
+) {
+    let (mut i, mut j) = (0, 0);
+    while i < old.len() && j < new.len() {
+        let (o, n) = (old[i], new[j]);
+        let k = if o < n {
+            // Only in the surviving candidates.
+            i += 1;
+            if !view.unchanged(o) {
+                continue;
+            }
+            o
+        } else {
+            j += 1;
+            i += (o == n) as usize;
+            n
+        };
+        next.push(k);
+        view.emit(k, exact);
+    }
+    for &o in &old[i..] {
+        if view.unchanged(o) {
+            next.push(o);
+            view.emit(o, exact);
+        }
+    }
+    for &n in &new[j..] {
+        next.push(n);
+        view.emit(n, exact);
     }
 }
