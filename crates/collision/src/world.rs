@@ -14,6 +14,9 @@ use crate::shape::Shape;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
+mod sync;
+pub use sync::ObjectSync;
+
 /// A handle to an object of a [`CollisionWorld`]: its slot and the slot's generation
 /// (the broadphase proxy handle of the object).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
@@ -140,6 +143,9 @@ pub struct CollisionWorld {
     changes: WorldPairChanges,
     narrowphase: NarrowPhase<ObjectHandle>,
     timings: UpdateTimings,
+    /// Reused buffer of [`CollisionWorld::sync_objects`] (its parallel passes).
+    #[cfg_attr(not(feature = "parallel"), allow(dead_code))]
+    sync_scratch: Vec<Option<sync::Synced>>,
 }
 
 impl CollisionWorld {

@@ -1,7 +1,8 @@
 //! The two-tree broadphase's parallel candidate search (split descents, chunked queries of
 //! the moved proxies) gives bit-identical pairs and changes on 1, 2 and 8 threads, and the
 //! pairs a brute force finds, on scenes large enough to take the parallel paths: every
-//! proxy moved (full descent), many moved (chunked queries), few moved (the serial loop).
+//! proxy moved (full descent), many moved (chunked queries), few moved (the serial loop);
+//! on 2 and 8 threads the merge of the candidates is split into chunks too.
 
 mod broadphase_common;
 
@@ -39,7 +40,7 @@ fn sorted(v: &[(ProxyHandle, ProxyHandle)]) -> Vec<(u32, u32)> {
 /// Runs `frames` updates of `n` proxies (one in ten static, some put to rest, a few
 /// removed), moving the fraction `moving` of the dynamic ones per frame, with the
 /// broadphase's full-descent fraction set to `full_fraction`; checks each frame against
-/// the brute force when `check`.
+/// the brute force when `check`. Also returns the largest candidate count seen.
 fn record(
     scene: Scene,
     n: usize,
@@ -47,7 +48,7 @@ fn record(
     full_fraction: Real,
     frames: usize,
     check: bool,
-) -> Frames {
+) -> (Frames, usize) {
     let mut rng = Rng(0x5eed ^ n as u64);
     let mut bp = TreeBroadPhase::default();
     bp.full_sweep_fraction = full_fraction;
@@ -63,6 +64,7 @@ fn record(
         }
     }
     let mut out = Frames::new();
+    let mut most = 0;
     for frame in 0..frames {
         for &(h, f) in &live {
             if f.is_static || rng.unit() >= moving {
@@ -80,6 +82,7 @@ fn record(
             bp.set_resting(live[0].0, false).unwrap();
         }
         let ch = bp.update_pairs().clone();
+        most = most.max(bp.candidate_count());
         let pairs = sorted(&bp.pairs());
         if check {
             assert_eq!(
@@ -90,7 +93,7 @@ fn record(
         }
         out.push((pairs, sorted(&ch.added), sorted(&ch.removed)));
     }
-    out
+    (out, most)
 }
 
 #[cfg(feature = "parallel")]
@@ -112,10 +115,14 @@ fn parallel_candidate_search_matches_one_thread_and_brute_force() {
         // (moved fraction, full-descent fraction): all moved by descent, all moved by
         // chunked queries, a third moved (chunked), a few moved (serial queries).
         for (moving, full) in [(1.0, 0.0), (1.0, 2.0), (0.35, 0.5), (0.01, 0.5)] {
-            let one = pools[0].install(|| record(scene, n, moving, full, 4, true));
+            let (one, most) = pools[0].install(|| record(scene, n, moving, full, 4, true));
             assert!(one.iter().all(|f| !f.0.is_empty()), "{scene:?}: no pairs");
+            if scene == Scene::Uniform {
+                // Enough candidates for the split merge on 2 and 8 threads (4096 a chunk).
+                assert!(most > 2 * 4096, "{most} candidates");
+            }
             for p in &pools[1..] {
-                let many = p.install(|| record(scene, n, moving, full, 4, false));
+                let (many, _) = p.install(|| record(scene, n, moving, full, 4, false));
                 assert_eq!(one, many, "{scene:?}, moving {moving}, full {full}");
             }
         }

@@ -27,12 +27,14 @@ mod any;
 pub mod brute_force;
 pub mod grid;
 pub mod hgrid;
+mod pair_keys;
 mod pairs;
 mod proxies;
 pub mod radix;
 pub mod sap;
 pub mod sort_sweep;
 mod tree_broadphase;
+mod tree_search;
 
 /// The dynamic AABB tree, moved to [`crate::bvh`] (compound shapes use it too).
 pub use crate::bvh::{DynamicTree, HalfSpace, InsertStrategy, TreeProxy};

@@ -10,14 +10,16 @@
 //! Candidates are kept sorted; each update drops those whose fat boxes separated and reports
 //! those whose exact boxes overlap.
 
+use super::pair_keys::sort_dedup_pair_keys;
+use super::tree_search::{merge_candidates, MergePart, Part, MOVED_CHUNK, PARALLEL_MIN_LEAVES};
 use super::{pair_key, unpack_pair, BroadPhase, Filter, InsertStrategy};
 use super::{PairCache, PairChanges, ProxyHandle, ProxyStore, TreeProxy};
 use crate::bvh::DynamicTree;
 use crate::error::Result;
 use crate::math::{Aabb, Real, Vec3};
 
-const MOVING: usize = 0;
-const RESTING: usize = 1;
+pub(super) const MOVING: usize = 0;
+pub(super) const RESTING: usize = 1;
 
 /// Two dynamic AABB trees (moving, resting/static) with a move buffer and a sorted candidate
 /// pair set. See the module docs.
@@ -25,7 +27,7 @@ const RESTING: usize = 1;
 pub struct TreeBroadPhase {
     store: ProxyStore,
     cache: PairCache,
-    trees: [DynamicTree; 2],
+    pub(super) trees: [DynamicTree; 2],
     /// Per slot: which tree and which leaf.
     leaves: Vec<(usize, TreeProxy)>,
     /// Per slot: the fat box (a copy of the leaf's, for the candidate pass).
@@ -46,14 +48,18 @@ pub struct TreeBroadPhase {
     /// Reused buffers of the parallel candidate search: the node-pair tasks of the split
     /// descent (and their expansion scratch), and per task or chunk of moved proxies its
     /// keys and traversal stacks.
-    tasks: Vec<(u32, u32)>,
-    cross_tasks: Vec<(u32, u32)>,
-    task_scratch: Vec<(u32, u32)>,
-    parts: Vec<Part>,
+    pub(super) tasks: Vec<(u32, u32)>,
+    pub(super) cross_tasks: Vec<(u32, u32)>,
+    pub(super) task_scratch: Vec<(u32, u32)>,
+    pub(super) parts: Vec<Part>,
     /// The largest capacities any part's buffers reached (keys, stack, pair stack): every
     /// part is grown to them, so that tasks whose work shifts from update to update stop
     /// allocating once the largest has been seen.
-    part_capacity: [usize; 3],
+    pub(super) part_capacity: [usize; 3],
+    /// Reused buffers of the parallel candidate merge ([`merge_candidates`]) and the
+    /// largest capacities they reached (surviving candidates, exact pairs).
+    merge_parts: Vec<MergePart>,
+    merge_capacity: [usize; 2],
     /// A proxy was removed since the last update (its candidate pairs must be dropped).
     removed_since_update: bool,
     /// Leaves re-inserted per update and tree by the incremental optimisation.
@@ -115,6 +121,8 @@ impl TreeBroadPhase {
             task_scratch: Vec::new(),
             parts: Vec::new(),
             part_capacity: [0; 3],
+            merge_parts: Vec::new(),
+            merge_capacity: [0; 2],
             removed_since_update: false,
             optimize_per_update: 4,
             full_sweep_fraction: 0.5,
@@ -183,10 +191,27 @@ impl TreeBroadPhase {
         }
     }
 
+    /// Whether [`TreeBroadPhase::update_slot`] would give live slot `i` a new fat box for
+    /// the checked `aabb` and `displacement` (read only).
+    #[inline]
+    pub(crate) fn slot_needs_refit(&self, i: usize, aabb: &Aabb, displacement: Vec3) -> bool {
+        let (t, leaf) = self.leaves[i];
+        self.trees[t].needs_new_fat(leaf.index as usize, aabb, displacement)
+    }
+
+    /// Records the checked box of live slot `i` whose fat box still holds it
+    /// ([`TreeBroadPhase::slot_needs_refit`] was `false`): [`TreeBroadPhase::update_slot`]
+    /// without the fat-box test.
+    #[inline]
+    pub(crate) fn set_slot_box(&mut self, i: usize, aabb: &Aabb) {
+        debug_assert!(self.fat[i].contains(aabb));
+        self.store.set_aabb_trusted(i, *aabb);
+    }
+
     /// Adds to `out` the candidate keys of moved proxy `m` against tree `t`. A pair of two
     /// moved proxies is reported only by the lower one (when both query, as Box2D v3's
     /// `b2PairQueryCallback`), so fewer duplicate keys reach the sort.
-    fn query_moved(&self, m: u32, t: usize, stack: &mut Vec<u32>, out: &mut Vec<u64>) {
+    pub(super) fn query_moved(&self, m: u32, t: usize, stack: &mut Vec<u32>, out: &mut Vec<u64>) {
         let fat = self.fat[m as usize];
         let moved = &self.moved_flag;
         self.trees[t].overlapping_leaves(&fat, stack, |other| {
@@ -194,160 +219,6 @@ impl TreeBroadPhase {
                 out.push(pair_key(m, other));
             }
         });
-    }
-}
-
-impl TreeBroadPhase {
-    /// The incremental candidate search over many moved proxies: `moved` (ascending) is cut
-    /// into chunks of [`MOVED_CHUNK`] (bounds that depend only on the count), each queried
-    /// into its own reused buffer, in parallel with the `parallel` feature; the buffers are
-    /// appended to `out` in chunk order, so `out` holds the keys of the serial loop in the
-    /// serial order. (Box2D v3 splits its move buffer into tasks the same way,
-    /// `b2UpdateBroadPhasePairs`.)
-    fn query_moved_chunked(&mut self, moved: &[u32], out: &mut Vec<u64>) {
-        let chunks = moved.len().div_ceil(MOVED_CHUNK);
-        let mut parts = std::mem::take(&mut self.parts);
-        if parts.len() < chunks {
-            parts.resize_with(chunks, Part::default);
-        }
-        let cap = self.part_capacity;
-        let this = &*self;
-        let run = |c: usize, part: &mut Part| {
-            part.prepare(cap);
-            let lo = c * MOVED_CHUNK;
-            let hi = (lo + MOVED_CHUNK).min(moved.len());
-            for &m in &moved[lo..hi] {
-                this.query_moved(m, MOVING, &mut part.stack, &mut part.keys);
-                this.query_moved(m, RESTING, &mut part.stack, &mut part.keys);
-            }
-        };
-        #[cfg(feature = "parallel")]
-        {
-            use rayon::prelude::*;
-            parts[..chunks]
-                .par_iter_mut()
-                .enumerate()
-                .with_max_len(1)
-                .for_each(|(c, part)| run(c, part));
-        }
-        #[cfg(not(feature = "parallel"))]
-        for (c, part) in parts[..chunks].iter_mut().enumerate() {
-            run(c, part);
-        }
-        for p in &parts[..chunks] {
-            out.extend_from_slice(&p.keys);
-        }
-        self.part_capacity = Part::capacities(&parts[..chunks], cap);
-        self.parts = parts;
-    }
-
-    /// The full candidate search's descents (self-pairs of the moving tree, moving ×
-    /// resting), split at the top levels of the trees into a fixed list of node-pair tasks
-    /// ([`DynamicTree::self_pair_tasks`], [`DynamicTree::tree_pair_tasks`]: the list depends
-    /// only on the trees), run in parallel with the `parallel` feature, each into its own
-    /// reused buffer; the buffers are appended to `out` in task order. The keys are sorted
-    /// afterwards, so the candidates do not depend on the thread count.
-    fn descend_split(&mut self, out: &mut Vec<u64>) {
-        let mut tasks = std::mem::take(&mut self.tasks);
-        let mut scratch = std::mem::take(&mut self.task_scratch);
-        let mut parts = std::mem::take(&mut self.parts);
-        tasks.reserve(5 * DESCENT_TASKS);
-        scratch.reserve(3 * DESCENT_TASKS);
-        self.cross_tasks.reserve(2 * DESCENT_TASKS);
-        let [moving, resting] = &self.trees;
-        moving.self_pair_tasks(DESCENT_TASKS, &mut tasks, &mut scratch);
-        let self_tasks = tasks.len();
-        // The moving × resting tasks follow the self-pair tasks in the same list.
-        scratch.clear();
-        let cross = &mut self.cross_tasks;
-        moving.tree_pair_tasks(resting, DESCENT_TASKS, cross, &mut scratch);
-        tasks.extend_from_slice(cross);
-        let n = tasks.len();
-        // At most 3 (self) and 2 (cross) node pairs per task of the last round, which
-        // started below DESCENT_TASKS: so the lists stop growing at once.
-        if parts.len() < 5 * DESCENT_TASKS {
-            parts.resize_with(5 * DESCENT_TASKS, Part::default);
-        }
-        if parts.len() < n {
-            parts.resize_with(n, Part::default);
-        }
-        let cap = self.part_capacity;
-        let run = |t: usize, part: &mut Part| {
-            part.prepare(cap);
-            let keys = &mut part.keys;
-            if t < self_tasks {
-                moving.self_pairs_from(tasks[t], &mut part.pair_stack, |a, b| {
-                    keys.push(pair_key(a, b))
-                });
-            } else {
-                moving.query_tree_from(resting, tasks[t], &mut part.pair_stack, |a, b| {
-                    keys.push(pair_key(a, b))
-                });
-            }
-        };
-        #[cfg(feature = "parallel")]
-        {
-            use rayon::prelude::*;
-            parts[..n]
-                .par_iter_mut()
-                .enumerate()
-                .with_max_len(1)
-                .for_each(|(t, part)| run(t, part));
-        }
-        #[cfg(not(feature = "parallel"))]
-        for (t, part) in parts[..n].iter_mut().enumerate() {
-            run(t, part);
-        }
-        for p in &parts[..n] {
-            out.extend_from_slice(&p.keys);
-        }
-        self.part_capacity = Part::capacities(&parts[..n], cap);
-        self.tasks = tasks;
-        self.task_scratch = scratch;
-        self.parts = parts;
-    }
-}
-
-/// Moved proxies per chunk of the parallel incremental search; the chunked path is taken
-/// from two chunks up (fewer moved proxies do not pay a fork).
-const MOVED_CHUNK: usize = 256;
-
-/// The full search is split into parallel tasks from this many leaves of the moving tree.
-const PARALLEL_MIN_LEAVES: usize = 512;
-
-/// The split descents are cut into at least this many node-pair tasks each (when the trees
-/// are deep enough).
-const DESCENT_TASKS: usize = 32;
-
-/// One task's or chunk's reused buffers in the parallel candidate search.
-#[derive(Debug, Clone, Default)]
-struct Part {
-    keys: Vec<u64>,
-    stack: Vec<u32>,
-    pair_stack: Vec<(u32, u32)>,
-}
-
-impl Part {
-    /// Clears the keys and grows every buffer to the capacities `cap` (keys, stack, pair
-    /// stack) if it has less.
-    fn prepare(&mut self, cap: [usize; 3]) {
-        self.keys.clear();
-        self.stack.clear();
-        self.pair_stack.clear();
-        self.keys.reserve(cap[0]);
-        self.stack.reserve(cap[1]);
-        self.pair_stack.reserve(cap[2]);
-    }
-
-    /// The largest capacities among `parts` and `cap`.
-    fn capacities(parts: &[Part], cap: [usize; 3]) -> [usize; 3] {
-        parts.iter().fold(cap, |c, p| {
-            [
-                c[0].max(p.keys.capacity()),
-                c[1].max(p.stack.capacity()),
-                c[2].max(p.pair_stack.capacity()),
-            ]
-        })
     }
 }
 
@@ -508,35 +379,15 @@ impl BroadPhase for TreeBroadPhase {
             } else {
                 let mut next = std::mem::take(&mut self.next_candidates);
                 next.clear();
-                let old = &self.candidates;
-                let (mut i, mut j) = (0, 0);
-                while i < old.len() && j < new_keys.len() {
-                    let (o, n) = (old[i], new_keys[j]);
-                    let k = if o < n {
-                        // Only in the surviving candidates.
-                        i += 1;
-                        if !view.unchanged(o) {
-                            continue;
-                        }
-                        o
-                    } else {
-                        j += 1;
-                        i += (o == n) as usize;
-                        n
-                    };
-                    next.push(k);
-                    view.emit(k, &mut exact);
-                }
-                for &o in &old[i..] {
-                    if view.unchanged(o) {
-                        next.push(o);
-                        view.emit(o, &mut exact);
-                    }
-                }
-                for &n in &new_keys[j..] {
-                    next.push(n);
-                    view.emit(n, &mut exact);
-                }
+                merge_candidates(
+                    &view,
+                    &self.candidates,
+                    &new_keys,
+                    &mut next,
+                    &mut exact,
+                    &mut self.merge_parts,
+                    &mut self.merge_capacity,
+                );
                 self.next_candidates = std::mem::replace(&mut self.candidates, next);
             }
         }
@@ -572,83 +423,8 @@ impl BroadPhase for TreeBroadPhase {
     }
 }
 
-/// Sorts pair keys ascending and removes duplicates (the result of `sort_unstable` then
-/// `dedup`), for keys whose lower slot index (the high 32 bits, see [`pair_key`]) is below
-/// `slots`.
-///
-/// A counting sort on the lower slot (one histogram pass, a prefix sum over the slots and a
-/// scatter) followed by an insertion sort, per bucket, on the full key: the keys of a bucket
-/// whose lower slot was queried come in traversal order but are few (the proxies touching
-/// one fat box), and those of an unmoved lower slot arrive already sorted, because the moved
-/// proxies are queried in ascending order. A bucket larger than [`SMALL_BUCKET`] (a box
-/// touching many, such as a ground plane) falls back to the library sort, so the worst case
-/// stays `O(n log n)`. On "3000 fall" (300 steps) the update's instructions drop from 1.39 G
-/// to 1.27 G, the sort from about 0.25 G to 0.13 G (the LSD radix sort of [`super::radix`]
-/// measured no better than the quicksort: six 11-bit passes' histograms for keys that differ
-/// in about 24 bits). Grouping pair keys by their first proxy follows Bullet's
-/// `btHashedOverlappingPairCache` (pairs hashed by the first proxy), done here as a sort so
-/// that the result is the sorted, thread-count-independent order the merge needs.
-pub(crate) fn sort_dedup_pair_keys(
-    keys: &mut Vec<u64>,
-    scratch: &mut Vec<u64>,
-    counts: &mut Vec<u32>,
-    slots: usize,
-) {
-    let n = keys.len();
-    if n < 64 {
-        keys.sort_unstable();
-        keys.dedup();
-        return;
-    }
-    counts.clear();
-    counts.resize(slots + 1, 0);
-    for &k in keys.iter() {
-        counts[(k >> 32) as usize + 1] += 1;
-    }
-    // counts[s] becomes the start of bucket s.
-    for s in 1..counts.len() {
-        counts[s] += counts[s - 1];
-    }
-    scratch.clear();
-    scratch.resize(n, 0);
-    for &k in keys.iter() {
-        let c = &mut counts[(k >> 32) as usize];
-        scratch[*c as usize] = k;
-        *c += 1;
-    }
-    // counts[s] is now the end of bucket s (the start of bucket s + 1).
-    keys.clear();
-    let mut start = 0usize;
-    for &end in counts[..slots].iter() {
-        let end = end as usize;
-        let bucket = &mut scratch[start..end];
-        if bucket.len() > SMALL_BUCKET {
-            bucket.sort_unstable();
-        } else {
-            for i in 1..bucket.len() {
-                let x = bucket[i];
-                let mut j = i;
-                while j > 0 && bucket[j - 1] > x {
-                    bucket[j] = bucket[j - 1];
-                    j -= 1;
-                }
-                bucket[j] = x;
-            }
-        }
-        for &k in bucket.iter() {
-            if keys.last() != Some(&k) {
-                keys.push(k);
-            }
-        }
-        start = end;
-    }
-}
-
-/// Buckets of [`sort_dedup_pair_keys`] up to this size are insertion-sorted.
-const SMALL_BUCKET: usize = 32;
-
 /// What the candidate pass of [`TreeBroadPhase::update_pairs`] reads, per slot.
-struct PairView<'a> {
+pub(super) struct PairView<'a> {
     alive: &'a [bool],
     boxes: &'a [Aabb],
     filters: &'a [Filter],
@@ -660,7 +436,7 @@ impl PairView<'_> {
     /// True when a surviving candidate stays one without a test: neither proxy moved (so
     /// their fat boxes still overlap) nor was removed.
     #[inline(always)]
-    fn unchanged(&self, k: u64) -> bool {
+    pub(super) fn unchanged(&self, k: u64) -> bool {
         let (a, b) = unpack_pair(k);
         let (a, b) = (a as usize, b as usize);
         !(self.moved[a] || self.moved[b] || (self.removals && !(self.alive[a] && self.alive[b])))
@@ -668,88 +444,11 @@ impl PairView<'_> {
 
     /// Pushes candidate `k` to `exact` when the exact boxes overlap and the filters accept.
     #[inline(always)]
-    fn emit(&self, k: u64, exact: &mut Vec<u64>) {
+    pub(super) fn emit(&self, k: u64, exact: &mut Vec<u64>) {
         let (a, b) = unpack_pair(k);
         let (a, b) = (a as usize, b as usize);
         if self.boxes[a].intersects(&self.boxes[b]) && self.filters[a].can_pair(&self.filters[b]) {
             exact.push(k);
         }
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::{pair_key, sort_dedup_pair_keys, SMALL_BUCKET};
-
-    /// A small deterministic generator (xorshift), so the test needs no dependency.
-    fn next(state: &mut u64) -> u64 {
-        *state ^= *state << 13;
-        *state ^= *state >> 7;
-        *state ^= *state << 17;
-        *state
-    }
-
-    /// The oracle: the library sort and dedup.
-    fn check(keys: &[u64], slots: usize) {
-        let mut expected = keys.to_vec();
-        expected.sort_unstable();
-        expected.dedup();
-        let mut got = keys.to_vec();
-        let (mut scratch, mut counts) = (Vec::new(), Vec::new());
-        sort_dedup_pair_keys(&mut got, &mut scratch, &mut counts, slots);
-        assert_eq!(got, expected, "{} keys over {slots} slots", keys.len());
-        // Reused buffers give the same result.
-        let mut again = keys.to_vec();
-        sort_dedup_pair_keys(&mut again, &mut scratch, &mut counts, slots);
-        assert_eq!(again, expected);
-    }
-
-    #[test]
-    fn matches_sort_and_dedup() {
-        let mut s = 0x9e37_79b9_7f4a_7c15u64;
-        for &(n, slots) in &[
-            (0, 1),
-            (1, 2),
-            (63, 10),
-            (64, 10),
-            (65, 3),
-            (500, 40),
-            (5000, 3000),
-        ] {
-            // Random pairs, with duplicates (each key pushed up to three times).
-            let mut keys = Vec::new();
-            while keys.len() < n {
-                let a = (next(&mut s) % slots as u64) as u32;
-                let b = (next(&mut s) % slots as u64) as u32;
-                if a == b {
-                    continue;
-                }
-                let k = pair_key(a, b);
-                for _ in 0..(next(&mut s) % 3 + 1) {
-                    keys.push(k);
-                }
-            }
-            check(&keys, slots);
-        }
-    }
-
-    #[test]
-    fn degenerate_buckets() {
-        // All keys in one bucket (a ground plane in slot 0), reversed: beyond the
-        // insertion-sort size, and exactly at it.
-        for m in [SMALL_BUCKET, SMALL_BUCKET + 1, 2000] {
-            let keys: Vec<u64> = (1..=m as u32).rev().map(|b| pair_key(0, b)).collect();
-            check(&keys, m + 1);
-        }
-        // Every key the same; the last slots of a large store; keys already sorted.
-        check(&[pair_key(3, 7); 100], 8);
-        let top = 99_999u32;
-        let keys: Vec<u64> = (0..100)
-            .rev()
-            .map(|i| pair_key(top - 100 + i, top))
-            .collect();
-        check(&keys, top as usize + 1);
-        let sorted: Vec<u64> = (0..200u32).map(|i| pair_key(i / 4, 1000 + i)).collect();
-        check(&sorted, 1000);
     }
 }

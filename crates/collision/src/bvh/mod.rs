@@ -16,6 +16,7 @@
 mod build;
 mod dynamic_tree;
 mod pair;
+mod quantize;
 mod static_bvh;
 mod traverse;
 mod tree_insert;
@@ -25,8 +26,7 @@ mod wide;
 
 pub use build::{MAX_LEAF_SIZE, NUM_BINS};
 pub use dynamic_tree::{DynamicTree, InsertStrategy, TreeProxy};
-pub use static_bvh::{
-    Bvh, BvhLayout, Quantization, QuantizedNode, UnquantizedNode, MAX_PRIMITIVES,
-};
+pub use quantize::Quantization;
+pub use static_bvh::{Bvh, BvhLayout, QuantizedNode, UnquantizedNode, MAX_PRIMITIVES};
 pub use tree_query::HalfSpace;
 pub use wide::WideNode;

@@ -10,9 +10,8 @@
 //! Ray–box tests follow the robust slab test of Ize, "Robust BVH Ray Traversal" (JCGT 2013):
 //! the exit distance is scaled by `1 + 2γ₃` so a ray touching a box is never culled.
 
-use super::static_bvh::{
-    leaf_range, Bvh, Nodes, Quantization, QuantizedNode, UnquantizedNode, LEAF_FLAG,
-};
+use super::quantize::Quantization;
+use super::static_bvh::{leaf_range, Bvh, Nodes, QuantizedNode, UnquantizedNode, LEAF_FLAG};
 use super::wide::{walk_ordered, WideRay};
 use crate::math::{Aabb, Real, Vec3, Vec3A, EPSILON};
 

@@ -5,6 +5,7 @@ use super::World;
 use crate::body::BodyType;
 use crate::world::StepReport;
 use carom_collision::math::{Real, Vec3};
+use carom_collision::world::ObjectSync;
 use carom_collision::{CaromError, Result};
 use std::time::{Duration, Instant};
 
@@ -136,11 +137,41 @@ impl World {
     }
 
     /// Copies the poses of moving bodies to their collision objects with speculative margins,
-    /// and the sleep state to the broadphase's resting hints.
+    /// and the sleep state to the broadphase's resting hints. On more than one thread the
+    /// moving bodies' objects are gathered and synced in one batch
+    /// ([`CollisionWorld::sync_objects`]: boxes and fat-box tests first, in parallel, then
+    /// the writes), in body order; a resting hint that changes first syncs the batch
+    /// gathered so far, so the broadphase sees the same sequence of operations as a
+    /// per-body sync. On one thread each object is synced at once.
+    ///
+    /// [`CollisionWorld::sync_objects`]: carom_collision::world::CollisionWorld::sync_objects
     #[inline(never)] // its own entry in profiles
     pub(super) fn sync(&mut self, dt: Real) -> Result<()> {
         let base = 0.5 * self.params.manifold.prediction;
         let speculative = self.params.speculative;
+        let mut syncs = std::mem::take(&mut self.syncs);
+        syncs.clear();
+        let result = self.gather_syncs(dt, base, speculative, &mut syncs);
+        let result = result.and_then(|()| self.collision.sync_objects(&syncs));
+        self.syncs = syncs;
+        result
+    }
+
+    /// The loop of [`World::sync`]: pushes the moving bodies' objects to `syncs`, and
+    /// applies resting hints and the static and sleeping bodies' changes.
+    fn gather_syncs(
+        &mut self,
+        dt: Real,
+        base: Real,
+        speculative: bool,
+        syncs: &mut Vec<ObjectSync>,
+    ) -> Result<()> {
+        // One thread gains nothing from the batch's parallel pass: sync each object at once
+        // (the same results, tested in `carom-collision`'s `world_sync_batch`).
+        #[cfg(feature = "parallel")]
+        let batch = rayon::current_num_threads() > 1;
+        #[cfg(not(feature = "parallel"))]
+        let batch = false;
         for i in 0..self.object_of.len() {
             let Some(obj) = self.object_of[i] else {
                 continue;
@@ -157,6 +188,9 @@ impl World {
             // current fat box, and the box update below then refits it in its new tree.
             let resting = !moving;
             if resting != self.resting[i] {
+                // The objects gathered so far are synced before the migration.
+                self.collision.sync_objects(syncs)?;
+                syncs.clear();
                 self.collision.set_resting(obj, resting)?;
                 self.resting[i] = resting;
             }
@@ -172,9 +206,18 @@ impl World {
                 } else {
                     (0.0, Vec3::ZERO)
                 };
-                // Pose, margin, motion, box and broadphase proxy in one call.
-                self.collision
-                    .sync_object(obj, pose, base + spin + motion.length(), motion)?;
+                // Pose, margin, motion, box and broadphase proxy, in the batch or at once.
+                let margin = base + spin + motion.length();
+                if batch {
+                    syncs.push(ObjectSync {
+                        handle: obj,
+                        pose,
+                        margin,
+                        motion,
+                    });
+                } else {
+                    self.collision.sync_object(obj, pose, margin, motion)?;
+                }
             } else {
                 let o = self.collision.get(obj)?;
                 let (teleported, has_motion) = (o.pose != pose, o.motion != Vec3::ZERO);
