@@ -3,7 +3,7 @@
 //! used by the persistent manifold, a feature id and the solver's accumulated impulses
 //! (Bullet's `btManifoldPoint`).
 
-use crate::math::{Isometry, Real, Vec3};
+use crate::math::{Isometry, Mat3, Real, Vec3};
 use crate::query::Contact;
 use serde::{Deserialize, Serialize};
 
@@ -66,6 +66,34 @@ impl ContactPoint {
             local_a: c.point_a,
             local_b: pose_b.inverse_transform_point(point_b),
             local_normal_b: pose_b.inverse_transform_vector(normal),
+            feature,
+            normal_impulse: 0.0,
+            tangent_impulse: [0.0; 2],
+            lifetime: 0,
+        }
+    }
+
+    /// [`ContactPoint::from_local_contact`] with the bodies' poses as rotation matrices
+    /// (`ra`, `rb`, e.g. [`Isometry::rotation_matrix`]) and translations (`ta`, `tb`), and
+    /// `rb_t` the transpose of `rb` (its inverse): four matrix–vector products instead of
+    /// four quaternion rotations, with the matrices built once per pair. The persistent
+    /// manifold refreshes its points with the same matrices.
+    #[inline]
+    pub fn from_local_contact_mat(
+        c: &Contact,
+        (ra, ta): (&Mat3, Vec3),
+        (rb_t, tb): (&Mat3, Vec3),
+        feature: FeatureId,
+    ) -> ContactPoint {
+        let point_b = *ra * c.point_b + ta;
+        let normal = -(*ra * c.normal);
+        ContactPoint {
+            distance: c.distance,
+            normal,
+            point_b,
+            local_a: c.point_a,
+            local_b: *rb_t * (point_b - tb),
+            local_normal_b: *rb_t * normal,
             feature,
             normal_impulse: 0.0,
             tangent_impulse: [0.0; 2],

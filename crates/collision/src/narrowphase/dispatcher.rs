@@ -513,7 +513,21 @@ impl Dispatcher {
         };
         let cfg = &local;
         let before = manifold.len();
-        manifold.refresh(pose_a, pose_b, cfg.breaking_threshold);
+        // The bodies' rotation matrices, built once per pair when there are points to
+        // refresh or generated points to convert (apart pairs skipped by their certificate
+        // need none).
+        let mut mats = None;
+        if before > 0 {
+            let (ra, rb) = (pose_a.rotation_matrix(), pose_b.rotation_matrix());
+            manifold.refresh_with(
+                &ra,
+                pose_a.translation,
+                &rb,
+                pose_b.translation,
+                cfg.breaking_threshold,
+            );
+            mats = Some((ra, rb));
+        }
         let pose_ab = pose_a.inv_mul(pose_b);
         if before == 0 {
             // An apart pair whose separating axis still proves the gap: nothing to generate.
@@ -568,11 +582,15 @@ impl Dispatcher {
                 }
                 _ => self.generate_into_with(a, b, &pose_ab, cfg, manifold.is_empty(), contacts)?,
             };
-            pts.extend(
-                contacts
-                    .iter()
-                    .map(|(c, id)| ContactPoint::from_local_contact(c, pose_a, pose_b, *id)),
-            );
+            if !contacts.is_empty() {
+                let (ra, rb) =
+                    mats.unwrap_or_else(|| (pose_a.rotation_matrix(), pose_b.rotation_matrix()));
+                let rb_t = rb.transpose();
+                let (ta, tb) = (pose_a.translation, pose_b.translation);
+                pts.extend(contacts.iter().map(|(c, id)| {
+                    ContactPoint::from_local_contact_mat(c, (&ra, ta), (&rb_t, tb), *id)
+                }));
+            }
             manifold.generated_at = full.then_some(pose_ab);
             if full {
                 manifold.replace_with(pts, cfg.merge_distance);

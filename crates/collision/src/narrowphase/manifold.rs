@@ -171,11 +171,14 @@ impl ContactManifold {
         if dt + 2.0 * sin_half * reach <= COHERENCE_DISTANCE {
             return true;
         }
+        // Each point's own displacement `(R - R0) x + Δt`, with the difference of the two
+        // rotation matrices formed once (two quaternion rotations per point before).
         let tol2 = COHERENCE_DISTANCE * COHERENCE_DISTANCE;
-        self.points.iter().all(|p| {
-            let d = pose_ab.transform_point(p.local_b) - p0.transform_point(p.local_b);
-            d.length_squared() <= tol2
-        })
+        let dr = Mat3::from_quat(pose_ab.rotation) - Mat3::from_quat(p0.rotation);
+        let dt = pose_ab.translation - p0.translation;
+        self.points
+            .iter()
+            .all(|p| (dr * p.local_b + dt).length_squared() <= tol2)
     }
 
     /// The deepest (smallest) distance, or `None` when empty.
@@ -191,16 +194,39 @@ impl ContactManifold {
         if self.points.is_empty() {
             return;
         }
+        let (ra, rb) = (pose_a.rotation_matrix(), pose_b.rotation_matrix());
+        self.refresh_with(
+            &ra,
+            pose_a.translation,
+            &rb,
+            pose_b.translation,
+            breaking_threshold,
+        );
+    }
+
+    /// [`ContactManifold::refresh`] with the bodies' rotation matrices `ra`, `rb` (their
+    /// quaternions' `Mat3::from_quat`) and translations `ta`, `tb` already at hand: the
+    /// dispatcher computes the matrices once per pair and shares them with the conversion
+    /// of newly generated points.
+    pub(crate) fn refresh_with(
+        &mut self,
+        ra: &Mat3,
+        ta: Vec3,
+        rb: &Mat3,
+        tb: Vec3,
+        breaking_threshold: Real,
+    ) {
+        if self.points.is_empty() {
+            return;
+        }
         if self.points.len() <= 2 {
             // One or two points: the scalar matrices, without the SIMD columns' set-up, which
             // costs more than it saves here (persistent capsule–box in the contacts bench:
             // 2.75 → 2.58 µs per 64 pairs). Same bits as the column path below.
-            let (ra, rb) = (pose_a.rotation_matrix(), pose_b.rotation_matrix());
-            let (ta, tb) = (pose_a.translation, pose_b.translation);
             self.points.retain_mut(|p| {
-                let a = ra * p.local_a + ta;
-                let b = rb * p.local_b + tb;
-                let n = rb * p.local_normal_b;
+                let a = *ra * p.local_a + ta;
+                let b = *rb * p.local_b + tb;
+                let n = *rb * p.local_normal_b;
                 let d = (a - b).dot(n);
                 if d.is_nan() || d > breaking_threshold {
                     return false;
@@ -217,24 +243,19 @@ impl ContactManifold {
             });
             return;
         }
-        // Rotation matrices once per manifold, as SIMD columns (`Vec3A`): three
-        // matrix–vector products per point, each three lane multiplies and two adds, summed
-        // in `Mat3 * Vec3`'s order (column by column, nothing fused), so every value has the
-        // scalar product's bits (the dot products too: `(x + y) + z` in both). In f64
-        // `Vec3A` is `Vec3` and this is the scalar code.
-        let cols = |q| {
-            let m = Mat3::from_quat(q);
-            [m.x_axis, m.y_axis, m.z_axis].map(Vec3A::from)
-        };
-        let (ra, rb) = (cols(pose_a.rotation), cols(pose_b.rotation));
-        let (ta, tb) = (
-            Vec3A::from(pose_a.translation),
-            Vec3A::from(pose_b.translation),
-        );
+        // Rotation matrices as SIMD columns (`Vec3A`): three matrix–vector products per
+        // point, each three lane multiplies and two adds, summed in `Mat3 * Vec3`'s order
+        // (column by column, nothing fused), so every value has the scalar product's bits
+        // (the dot products too: `(x + y) + z` in both). In f64 `Vec3A` is `Vec3` and this
+        // is the scalar code.
+        let cols = |m: &Mat3| [m.x_axis, m.y_axis, m.z_axis].map(Vec3A::from);
+        let (ra, rb) = (cols(ra), cols(rb));
+        let (ta, tb) = (Vec3A::from(ta), Vec3A::from(tb));
         let mul = |m: &[Vec3A; 3], v: Vec3| m[0] * v.x + m[1] * v.y + m[2] * v.z;
         let limit2 = breaking_threshold * breaking_threshold;
         // In-place compaction, in order (what `retain_mut` did, without its per-point
-        // closure call).
+        // closure call); a kept point's four changed fields are written where it lands,
+        // not the whole point copied out and back.
         let mut kept = 0;
         for i in 0..self.points.len() {
             let p = &self.points[i];
@@ -249,12 +270,14 @@ impl ContactManifold {
             if drift.length_squared() > limit2 {
                 continue;
             }
-            let mut p = *p;
+            if kept != i {
+                self.points[kept] = self.points[i];
+            }
+            let p = &mut self.points[kept];
             p.distance = d;
             p.normal = to_vec3(n);
             p.point_b = to_vec3(b);
             p.lifetime = p.lifetime.saturating_add(1);
-            self.points[kept] = p;
             kept += 1;
         }
         self.points.truncate(kept);
