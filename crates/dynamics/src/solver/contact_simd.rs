@@ -89,6 +89,16 @@ impl V3 {
         }
     }
 
+    /// `self × o` in glam's order of operations (`Vec3::cross`).
+    #[inline(always)]
+    fn cross(self, o: V3) -> V3 {
+        V3 {
+            x: self.y * o.z - o.y * self.z,
+            y: self.z * o.x - o.z * self.x,
+            z: self.x * o.y - o.x * self.y,
+        }
+    }
+
     #[inline(always)]
     fn scale(self, s: W) -> V3 {
         V3 {
@@ -99,21 +109,41 @@ impl V3 {
     }
 }
 
-/// Four [`super::contact::ContactRow`]s.
+/// The stored half of four [`super::contact::ContactRow`]s: the angular impulse directions
+/// premultiplied by the inverse world inertias and the effective mass. The angular
+/// Jacobians `r × d` themselves are not stored: each pass recomputes them from the point's
+/// lever arms ([`WidePoint::arm_a`], shared by the normal and both tangent rows), as Box2D v3
+/// recomputes its Jacobians from the anchors (`b2ContactConstraintSIMD` keeps anchors, not
+/// Jacobians). Same operations as the scalar `ContactRow::new`, so the same bits.
 #[derive(Debug, Clone, Copy, Default)]
 struct WideRow {
-    ang_a: V3,
-    ang_b: V3,
     inv_ang_a: V3,
     inv_ang_b: V3,
     mass: W,
 }
 
-impl WideRow {
+/// The angular Jacobians `r_a × d`, `r_b × d` of one row of four points, recomputed from the
+/// lever arms in each pass (see [`WideRow`]).
+#[derive(Clone, Copy)]
+struct Angular {
+    a: V3,
+    b: V3,
+}
+
+impl Angular {
+    /// `(r_a × d, r_b × d)` in glam's order of operations (the bits of `Vec3::cross`).
+    #[inline(always)]
+    fn new(p: &WidePoint, d: V3) -> Angular {
+        Angular {
+            a: p.arm_a.cross(d),
+            b: p.arm_b.cross(d),
+        }
+    }
+
     /// `J v`, as `ContactRow::velocity`.
     #[inline(always)]
     fn velocity(&self, d: V3, a: &WideBody, b: &WideBody) -> W {
-        d.dot(b.v.sub(a.v)) + self.ang_b.dot(b.w) - self.ang_a.dot(a.w)
+        d.dot(b.v.sub(a.v)) + self.b.dot(b.w) - self.a.dot(a.w)
     }
 
     /// `J Δx`, as `ContactRow::displacement`, given its linear part `d · (Δx_b − Δx_a)`
@@ -121,16 +151,18 @@ impl WideRow {
     /// a pass, so the solve computes it once per constraint).
     #[inline(always)]
     fn displacement(&self, linear: W, a: &WideBody, b: &WideBody) -> W {
-        linear + self.ang_b.dot(b.dq) - self.ang_a.dot(a.dq)
+        linear + self.b.dot(b.dq) - self.a.dot(a.dq)
     }
 
     /// `J v` given its linear part `u = d · (v_b − v_a)`, which the solve tracks per
     /// constraint and direction (see [`solve_soft`]).
     #[inline(always)]
     fn velocity_from(&self, u: W, a: &WideBody, b: &WideBody) -> W {
-        u + self.ang_b.dot(b.w) - self.ang_a.dot(a.w)
+        u + self.b.dot(b.w) - self.a.dot(a.w)
     }
+}
 
+impl WideRow {
     /// The angular half of [`WideRow::apply`]; the linear half is applied once per
     /// constraint (see [`solve_soft`]).
     #[inline(always)]
@@ -152,6 +184,10 @@ impl WideRow {
 /// Point `k` of four constraints (zero rows in lanes with fewer points).
 #[derive(Debug, Clone, Copy, Default)]
 struct WidePoint {
+    /// Lever arms of the point from the centres of mass of A and B (zero in lanes without
+    /// the point).
+    arm_a: V3,
+    arm_b: V3,
     normal_row: WideRow,
     tangent_rows: [WideRow; 2],
     separation: W,
@@ -510,12 +546,14 @@ impl Linear {
 #[inline(always)]
 fn solve_friction(c: &mut WideConstraint, a: &mut WideBody, b: &mut WideBody, lin: &mut Linear) {
     let one = W::splat(1.0);
+    let [t0, t1] = c.tangent;
     for p in c.points[..c.len].iter_mut() {
+        let (j0, j1) = (Angular::new(p, t0), Angular::new(p, t1));
         let [r0, r1] = &p.tangent_rows;
         let old = p.tangent_impulse;
         let new = [
-            old[0] - r0.mass * r0.velocity_from(lin.u[1], a, b),
-            old[1] - r1.mass * r1.velocity_from(lin.u[2], a, b),
+            old[0] - r0.mass * j0.velocity_from(lin.u[1], a, b),
+            old[1] - r1.mass * j1.velocity_from(lin.u[2], a, b),
         ];
         let max = c.friction * p.normal_impulse;
         let len_sq = new[0] * new[0] + new[1] * new[1];
@@ -550,7 +588,8 @@ pub(crate) fn solve_soft(
     let linear = n.dot(b.dp.sub(a.dp));
     for p in c.points[..c.len].iter_mut() {
         let row = &p.normal_row;
-        let s = p.separation + row.displacement(linear, a, b);
+        let j = Angular::new(p, n);
+        let s = p.separation + j.displacement(linear, a, b);
         let gap = s.simd_gt(zero);
         let (bias, mass_scale, impulse_scale) = if use_bias {
             (
@@ -561,7 +600,7 @@ pub(crate) fn solve_soft(
         } else {
             (gap.select(s * inv_h, zero), one, zero)
         };
-        let vn = row.velocity_from(lin.u[0], a, b);
+        let vn = j.velocity_from(lin.u[0], a, b);
         let lambda = -row.mass * mass_scale * (vn + bias) - impulse_scale * p.normal_impulse;
         let new = (p.normal_impulse + lambda).max(zero);
         let d = new - p.normal_impulse;
@@ -596,7 +635,7 @@ pub(crate) fn apply_restitution(
         let skip = p.relative_velocity.simd_gt(threshold) | p.max_normal_impulse.simd_eq(zero);
         let active = bouncy & !skip;
         let row = &p.normal_row;
-        let vn = row.velocity(n, a, b);
+        let vn = Angular::new(p, n).velocity(n, a, b);
         let lambda = -row.mass * (vn + c.restitution * p.relative_velocity);
         let new = active.select((p.normal_impulse + lambda).max(zero), p.normal_impulse);
         row.apply(n, new - p.normal_impulse, a, b);

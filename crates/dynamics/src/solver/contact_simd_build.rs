@@ -75,16 +75,6 @@ fn mat_mul(m: &[[W; 3]; 3], v: V3) -> V3 {
     }
 }
 
-/// `a × b` in every lane, in glam's order.
-#[inline(always)]
-fn cross(a: V3, b: V3) -> V3 {
-    V3 {
-        x: a.y * b.z - b.y * a.z,
-        y: a.z * b.x - b.z * a.x,
-        z: a.x * b.y - b.x * a.y,
-    }
-}
-
 /// Lanes of `v` where `mask` is set, zero elsewhere.
 #[inline(always)]
 fn keep(mask: W, v: V3) -> V3 {
@@ -217,27 +207,29 @@ impl WideConstraint {
             let present = lens.simd_gt(W::splat(k as Real));
             let all_present = present.all();
             let (ra, rb) = (inputs.arm_a[k], inputs.arm_b[k]);
+            // Zero in the lanes without the point (`set_lane` wrote zero arms there).
+            p.arm_a = ra;
+            p.arm_b = rb;
             let [t0, t1] = &mut p.tangent_rows;
             for (row, d) in [&mut p.normal_row, t0, t1].into_iter().zip(dirs) {
-                let (ang_a, ang_b) = (cross(ra, d), cross(rb, d));
+                let (ang_a, ang_b) = (ra.cross(d), rb.cross(d));
                 let (inv_ang_a, inv_ang_b) = (mat_mul(&ia, ang_a), mat_mul(&ib, ang_b));
                 let k = inv_m + ang_a.dot(inv_ang_a) + ang_b.dot(inv_ang_b);
                 // `inv_or_zero`, and no mass for an absent point.
                 let mass = (k.simd_gt(eps) & present).select(one / k, zero);
                 *row = if all_present {
                     WideRow {
-                        ang_a,
-                        ang_b,
                         inv_ang_a,
                         inv_ang_b,
                         mass,
                     }
                 } else {
                     // Zero rows (not `-0.0` from `0 × d`) in the absent lanes, as a scalar
-                    // `ContactRow::ZERO`.
+                    // `ContactRow::ZERO`. The solve recomputes `r × d` from the zero arms
+                    // there, which may give `-0.0`; it only meets the zero mass and the
+                    // zero impulse of the lane, so the impulse change stays `+0.0` and the
+                    // `+0.0` rows here leave the bodies' bits alone.
                     WideRow {
-                        ang_a: keep(present, ang_a),
-                        ang_b: keep(present, ang_b),
                         inv_ang_a: keep(present, inv_ang_a),
                         inv_ang_b: keep(present, inv_ang_b),
                         mass,

@@ -271,13 +271,19 @@ fn assert_lane(w: &WideConstraint, l: usize, c: Option<&ContactConstraint>, bodi
             PointConstraint::ZERO
         };
         let rows = [
-            (&wp.normal_row, &p.normal_row),
-            (&wp.tangent_rows[0], &p.tangent_rows[0]),
-            (&wp.tangent_rows[1], &p.tangent_rows[1]),
+            (&wp.normal_row, &p.normal_row, w.normal),
+            (&wp.tangent_rows[0], &p.tangent_rows[0], w.tangent[0]),
+            (&wp.tangent_rows[1], &p.tangent_rows[1], w.tangent[1]),
         ];
-        for (wr, r) in rows {
-            assert_eq!(lane3(&wr.ang_a), r.ang_a);
-            assert_eq!(lane3(&wr.ang_b), r.ang_b);
+        assert_eq!(lane3(&wp.arm_a), p.arm_a);
+        assert_eq!(lane3(&wp.arm_b), p.arm_b);
+        for (wr, r, d) in rows {
+            // The solve's recomputed Jacobian is the scalar row's, bit for bit (up to the
+            // sign of zero in a lane without the point, where the row's mass is zero).
+            let j = Angular::new(wp, d);
+            let bits = |v: Vec3| v.to_array().map(|x| if x == 0.0 { 0 } else { x.to_bits() });
+            assert_eq!(bits(lane3(&j.a)), bits(r.ang_a));
+            assert_eq!(bits(lane3(&j.b)), bits(r.ang_b));
             assert_eq!(lane3(&wr.inv_ang_a), r.inv_ang_a);
             assert_eq!(lane3(&wr.inv_ang_b), r.inv_ang_b);
             assert_eq!(lane(&wr.mass).to_bits(), r.mass.to_bits());
