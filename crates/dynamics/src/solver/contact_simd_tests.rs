@@ -204,9 +204,40 @@ fn wide_solve_equals_scalar_solves() {
             );
             write_back(&wide, &mut cons);
             compare(&bodies, &bodies2, &cons, &cons2);
+            same_bits(&bodies, &bodies2, &cons, &cons2);
         }
         // Static body never written.
         assert_eq!(bodies[0], bodies2[0]);
+    }
+}
+
+/// The wide passes recompute the rows' `r × d` from the lever arms in the scalar order, so
+/// they give the scalar routines' velocities and impulses bit for bit, not only to
+/// round-off.
+fn same_bits(
+    bodies: &[SolverBody],
+    bodies2: &[SolverBody],
+    cons: &[ContactConstraint],
+    cons2: &[ContactConstraint],
+) {
+    let bits = |v: Vec3| v.to_array().map(|x| x.to_bits());
+    for (i, (x, y)) in bodies.iter().zip(bodies2).enumerate() {
+        assert_eq!(bits(x.v), bits(y.v), "body {i} v");
+        assert_eq!(bits(x.w), bits(y.w), "body {i} w");
+    }
+    for (c, d) in cons.iter().zip(cons2) {
+        for (p, q) in c.points[..c.len].iter().zip(&d.points[..d.len]) {
+            let imp = |p: &PointConstraint| {
+                [
+                    p.normal_impulse,
+                    p.tangent_impulse[0],
+                    p.tangent_impulse[1],
+                    p.max_normal_impulse,
+                ]
+                .map(|x| x.to_bits())
+            };
+            assert_eq!(imp(p), imp(q), "manifold {}", c.manifold);
+        }
     }
 }
 
@@ -494,4 +525,17 @@ fn frame_solve_matches_row_by_row_solve() {
         after[j] = b;
     }
     assert_eq!(before, after);
+}
+
+/// The layout the solve streams through: a point keeps its two lever arms, three rows of
+/// `I⁻¹ (r × d)` (both bodies) and effective mass, and six impulse and separation values —
+/// 33 lane values (528 bytes in f32), down from 45 (720 bytes) while the rows also kept
+/// `r × d`.
+#[test]
+fn a_wide_point_is_33_lane_values() {
+    assert_eq!(
+        std::mem::size_of::<WidePoint>(),
+        33 * std::mem::size_of::<W>()
+    );
+    assert_eq!(std::mem::size_of::<WideRow>(), 7 * std::mem::size_of::<W>());
 }

@@ -188,9 +188,7 @@ fn start_block_sweeps_claim_every_block_once() {
         for (s, &n) in sizes.iter().enumerate() {
             list.push(s, n);
         }
-        let runs: Vec<AtomicUsize> = (0..sizes.len() * 37)
-            .map(|_| AtomicUsize::new(0))
-            .collect();
+        let runs: Vec<AtomicUsize> = (0..sizes.len() * 37).map(|_| AtomicUsize::new(0)).collect();
         for round in 0..4 {
             pool(threads).install(|| {
                 list.run(threads, |s, b, _| {
