@@ -53,8 +53,12 @@ pub(crate) type W = <Real as Lanes>::W;
 /// Lanes per wide constraint.
 pub(crate) const LANES: usize = 4;
 
-/// Lane body slot of a padding lane.
+/// Colour-order index of a padding lane in [`WideScratch::members`].
 const NONE: usize = usize::MAX;
+
+/// Body slot, manifold index of a padding lane in a [`WideConstraint`] (whose indices are
+/// `u32`: half the bytes of `usize`, and slots and manifold indices stay far below 2³²).
+const NO_SLOT: u32 = u32::MAX;
 
 /// A vector of four lanes of [`Vec3`](carom_collision::math::Vec3).
 #[derive(Debug, Clone, Copy, Default)]
@@ -191,7 +195,6 @@ struct WidePoint {
     normal_row: WideRow,
     tangent_rows: [WideRow; 2],
     separation: W,
-    relative_velocity: W,
     normal_impulse: W,
     tangent_impulse: [W; 2],
     max_normal_impulse: W,
@@ -201,17 +204,17 @@ struct WidePoint {
 /// `b2ContactConstraintSIMD`).
 #[derive(Debug, Clone)]
 pub(crate) struct WideConstraint {
-    /// Body slots of each lane (`NONE` for padding).
-    a: [usize; LANES],
-    b: [usize; LANES],
+    /// Body slots of each lane (`NO_SLOT` for padding).
+    a: [u32; LANES],
+    b: [u32; LANES],
     /// Whether the solve writes the lane's body back (dynamic bodies only: a static or
     /// kinematic body may be shared by several lanes and threads, and is only read).
     write_a: [bool; LANES],
     write_b: [bool; LANES],
-    /// Manifold of each lane (`NONE` for padding), where `store` writes the impulses.
-    manifold: [usize; LANES],
+    /// Manifold of each lane (`NO_SLOT` for padding), where `store` writes the impulses.
+    manifold: [u32; LANES],
     /// Point count of each lane.
-    lens: [usize; LANES],
+    lens: [u32; LANES],
     inv_m_a: W,
     inv_m_b: W,
     normal: V3,
@@ -224,6 +227,10 @@ pub(crate) struct WideConstraint {
     points: [WidePoint; MAX_MANIFOLD_POINTS],
     /// Largest point count of the lanes.
     len: usize,
+    /// Normal relative velocity of each point at preparation, read only by the restitution
+    /// pass: kept out of [`WidePoint`], so the points the solve, relax and warm-start passes
+    /// stream are 32 lane values (512 bytes, eight cache lines) instead of 33.
+    relative_velocity: [W; MAX_MANIFOLD_POINTS],
 }
 
 /// The velocities and position deltas of four bodies (Box2D v3's `b2BodyStateW`).
@@ -241,12 +248,12 @@ pub(crate) struct WideBody {
 /// ([`SolverBody::state`]), read as three four-wide rows and transposed with three 4×4
 /// transposes, which leave exactly the twelve lane vectors (`v.x … dq.z`).
 #[inline(always)]
-fn gather(bodies: &[SolverBody], slots: &[usize; LANES], inv_m: W) -> WideBody {
-    let row = |s: usize| {
-        if s == NONE {
+fn gather(bodies: &[SolverBody], slots: &[u32; LANES], inv_m: W) -> WideBody {
+    let row = |s: u32| {
+        if s == NO_SLOT {
             [[0.0; LANES]; 3]
         } else {
-            bodies[s].state()
+            bodies[s as usize].state()
         }
     };
     // Not `slots.map`: that call was left out of line in the stage executor (module
@@ -291,7 +298,7 @@ unsafe fn scatter(
     body: &WideBody,
     bodies: *mut SolverBody,
     len: usize,
-    slots: &[usize; LANES],
+    slots: &[u32; LANES],
     write: &[bool; LANES],
 ) {
     let r0 = W::transpose([body.v.x, body.v.y, body.v.z, body.w.x]);
@@ -300,7 +307,7 @@ unsafe fn scatter(
         if !write[l] {
             continue;
         }
-        let s = slots[l];
+        let s = slots[l] as usize;
         assert!(s < len);
         let target = &mut *bodies.add(s);
         target.set_velocities(r0[l].to_array(), r1[l].to_array());
@@ -631,12 +638,12 @@ pub(crate) fn apply_restitution(
     let threshold = W::splat(-threshold);
     let bouncy = !c.restitution.simd_eq(zero);
     let n = c.normal;
-    for p in c.points[..c.len].iter_mut() {
-        let skip = p.relative_velocity.simd_gt(threshold) | p.max_normal_impulse.simd_eq(zero);
+    for (p, &v0) in c.points[..c.len].iter_mut().zip(&c.relative_velocity) {
+        let skip = v0.simd_gt(threshold) | p.max_normal_impulse.simd_eq(zero);
         let active = bouncy & !skip;
         let row = &p.normal_row;
         let vn = Angular::new(p, n).velocity(n, a, b);
-        let lambda = -row.mass * (vn + c.restitution * p.relative_velocity);
+        let lambda = -row.mass * (vn + c.restitution * v0);
         let new = active.select((p.normal_impulse + lambda).max(zero), p.normal_impulse);
         row.apply(n, new - p.normal_impulse, a, b);
         p.normal_impulse = new;

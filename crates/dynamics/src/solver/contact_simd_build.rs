@@ -8,7 +8,7 @@
 //! neither zeroes nor copies the (large) constraint arrays. Box2D v3 prepares its SIMD constraints the same way
 //! (`b2PrepareContactsTask` writes `b2ContactConstraintSIMD` lanes directly).
 
-use super::{WideConstraint, WidePoint, WideRow, WideScratch, LANES, NONE, V3, W};
+use super::{WideConstraint, WidePoint, WideRow, WideScratch, LANES, NONE, NO_SLOT, V3, W};
 use crate::contact::{ContactManifold, MAX_MANIFOLD_POINTS};
 use crate::solver::contact::ContactConstraint;
 use crate::solver::SolverBody;
@@ -27,6 +27,17 @@ fn put3(v: &mut V3, l: usize, x: Vec3) {
     put(&mut v.x, l, x.x);
     put(&mut v.y, l, x.y);
     put(&mut v.z, l, x.z);
+}
+
+/// `x` as a lane index of a [`WideConstraint`] (body slot, manifold index).
+#[inline(always)]
+fn lane_index(x: usize) -> u32 {
+    let i = u32::try_from(x).unwrap_or(NO_SLOT);
+    assert!(
+        i != NO_SLOT,
+        "index {x} does not fit a wide constraint's u32 lane index"
+    );
+    i
 }
 
 /// Lane `l` of `v`.
@@ -94,7 +105,6 @@ impl WidePoint {
         let p = (k < c.len).then(|| &c.points[k]);
         let val = |f: fn(&super::super::contact::PointConstraint) -> Real| p.map_or(0.0, f);
         put(&mut self.separation, l, val(|p| p.separation));
-        put(&mut self.relative_velocity, l, val(|p| p.relative_velocity));
         put(&mut self.normal_impulse, l, val(|p| p.normal_impulse));
         put(
             &mut self.tangent_impulse[0],
@@ -118,11 +128,11 @@ impl WideConstraint {
     /// A constraint with four padding lanes.
     pub(super) fn empty() -> Self {
         WideConstraint {
-            a: [NONE; LANES],
-            b: [NONE; LANES],
+            a: [NO_SLOT; LANES],
+            b: [NO_SLOT; LANES],
             write_a: [false; LANES],
             write_b: [false; LANES],
-            manifold: [NONE; LANES],
+            manifold: [NO_SLOT; LANES],
             lens: [0; LANES],
             inv_m_a: W::default(),
             inv_m_b: W::default(),
@@ -135,6 +145,7 @@ impl WideConstraint {
             impulse_scale: W::default(),
             points: [WidePoint::default(); MAX_MANIFOLD_POINTS],
             len: 0,
+            relative_velocity: [W::default(); MAX_MANIFOLD_POINTS],
         }
     }
 
@@ -153,12 +164,12 @@ impl WideConstraint {
         let c = c.unwrap_or(&ContactConstraint::EMPTY);
         let pad = c.len == 0;
         let (a, b) = if pad { (NONE, NONE) } else { (c.a, c.b) };
-        self.a[l] = a;
-        self.b[l] = b;
+        self.a[l] = if pad { NO_SLOT } else { lane_index(a) };
+        self.b[l] = if pad { NO_SLOT } else { lane_index(b) };
         self.write_a[l] = !pad && bodies[a].dynamic;
         self.write_b[l] = !pad && bodies[b].dynamic;
-        self.manifold[l] = if pad { NONE } else { c.manifold };
-        self.lens[l] = c.len;
+        self.manifold[l] = if pad { NO_SLOT } else { lane_index(c.manifold) };
+        self.lens[l] = c.len as u32;
         let body = |s: usize| (!pad).then(|| &bodies[s]);
         let (ba, bb) = (body(a), body(b));
         put(&mut self.inv_m_a, l, ba.map_or(0.0, |x| x.inv_m));
@@ -175,6 +186,11 @@ impl WideConstraint {
         put(&mut self.impulse_scale, l, c.softness.impulse_scale);
         for (k, wp) in self.points[..c.len].iter_mut().enumerate() {
             wp.set_lane(l, c, k);
+            put(
+                &mut self.relative_velocity[k],
+                l,
+                c.points[k].relative_velocity,
+            );
         }
         for k in 0..MAX_MANIFOLD_POINTS {
             let p = (k < c.len).then(|| &c.points[k]);
@@ -192,8 +208,9 @@ impl WideConstraint {
     /// length, and a group of one-point lanes builds one point instead of four.
     fn finish(&mut self, inputs: &RowInputs) {
         for l in 0..LANES {
-            for k in self.lens[l]..self.len {
+            for k in self.lens[l] as usize..self.len {
                 self.points[k].set_lane(l, &ContactConstraint::EMPTY, k);
+                put(&mut self.relative_velocity[k], l, 0.0);
             }
         }
         let (ia, ib) = (wide_mat(&inputs.inv_i_a), wide_mat(&inputs.inv_i_b));
@@ -419,13 +436,18 @@ pub(crate) unsafe fn store_range(
         let w = &*cons.add(i);
         for l in 0..LANES {
             let m_index = w.manifold[l];
-            if m_index == NONE {
+            if m_index == NO_SLOT {
                 continue;
             }
+            let m_index = m_index as usize;
             assert!(m_index < len);
             let m = &mut *manifolds.add(m_index);
             m.tangent = get3(&w.tangent[0], l);
-            for (out, wp) in m.points_mut().iter_mut().zip(&w.points[..w.lens[l]]) {
+            for (out, wp) in m
+                .points_mut()
+                .iter_mut()
+                .zip(&w.points[..w.lens[l] as usize])
+            {
                 out.normal_impulse = wp.normal_impulse.as_array()[l] * scale;
                 out.tangent_impulse = [
                     wp.tangent_impulse[0].as_array()[l] * scale,
@@ -442,7 +464,10 @@ pub(crate) unsafe fn store_range(
 pub(crate) fn write_back(wide: &WideScratch, cons: &mut [ContactConstraint]) {
     for w in &wide.cons {
         for l in 0..LANES {
-            let Some(c) = cons.iter_mut().find(|c| c.manifold == w.manifold[l]) else {
+            let Some(c) = cons
+                .iter_mut()
+                .find(|c| w.manifold[l] != NO_SLOT && c.manifold == w.manifold[l] as usize)
+            else {
                 continue;
             };
             for (k, p) in c.points[..c.len].iter_mut().enumerate() {

@@ -275,17 +275,16 @@ fn assert_lane(w: &WideConstraint, l: usize, c: Option<&ContactConstraint>, bodi
     let lane3 = |v: &V3| Vec3::new(lane(&v.x), lane(&v.y), lane(&v.z));
     let empty = ContactConstraint::EMPTY;
     let c_or = c.unwrap_or(&empty);
-    assert_eq!(w.manifold[l], c.map_or(NONE, |c| c.manifold));
-    assert_eq!(w.lens[l], c_or.len);
-    assert_eq!((w.a[l], w.b[l]), c.map_or((NONE, NONE), |c| (c.a, c.b)));
+    let index = |x: u32| if x == NO_SLOT { NONE } else { x as usize };
+    assert_eq!(index(w.manifold[l]), c.map_or(NONE, |c| c.manifold));
+    assert_eq!(w.lens[l] as usize, c_or.len);
+    let (wa, wb) = (index(w.a[l]), index(w.b[l]));
+    assert_eq!((wa, wb), c.map_or((NONE, NONE), |c| (c.a, c.b)));
     let dynamic = |s: usize| s != NONE && bodies[s].dynamic;
-    assert_eq!(
-        (w.write_a[l], w.write_b[l]),
-        (dynamic(w.a[l]), dynamic(w.b[l]))
-    );
+    assert_eq!((w.write_a[l], w.write_b[l]), (dynamic(wa), dynamic(wb)));
     let inv_m = |s: usize| if s == NONE { 0.0 } else { bodies[s].inv_m };
-    assert_eq!(lane(&w.inv_m_a).to_bits(), inv_m(w.a[l]).to_bits());
-    assert_eq!(lane(&w.inv_m_b).to_bits(), inv_m(w.b[l]).to_bits());
+    assert_eq!(lane(&w.inv_m_a).to_bits(), inv_m(wa).to_bits());
+    assert_eq!(lane(&w.inv_m_b).to_bits(), inv_m(wb).to_bits());
     assert_eq!(lane3(&w.normal), c_or.normal);
     assert_eq!(lane3(&w.tangent[0]), c_or.tangent[0]);
     assert_eq!(lane3(&w.tangent[1]), c_or.tangent[1]);
@@ -320,7 +319,7 @@ fn assert_lane(w: &WideConstraint, l: usize, c: Option<&ContactConstraint>, bodi
             assert_eq!(lane(&wr.mass).to_bits(), r.mass.to_bits());
         }
         assert_eq!(lane(&wp.separation), p.separation);
-        assert_eq!(lane(&wp.relative_velocity), p.relative_velocity);
+        assert_eq!(lane(&w.relative_velocity[k]), p.relative_velocity);
         assert_eq!(lane(&wp.normal_impulse), p.normal_impulse);
         assert_eq!(lane(&wp.tangent_impulse[0]), p.tangent_impulse[0]);
         assert_eq!(lane(&wp.tangent_impulse[1]), p.tangent_impulse[1]);
@@ -528,14 +527,29 @@ fn frame_solve_matches_row_by_row_solve() {
 }
 
 /// The layout the solve streams through: a point keeps its two lever arms, three rows of
-/// `I⁻¹ (r × d)` (both bodies) and effective mass, and six impulse and separation values —
-/// 33 lane values (528 bytes in f32), down from 45 (720 bytes) while the rows also kept
-/// `r × d`.
+/// `I⁻¹ (r × d)` (both bodies) and effective mass, and five impulse and separation values —
+/// 32 lane values (512 bytes in f32, eight cache lines), down from 45 (720 bytes) while the
+/// rows also kept `r × d` and 33 while the point kept its relative velocity (now in the
+/// constraint, read by the restitution pass only).
 #[test]
-fn a_wide_point_is_33_lane_values() {
+fn a_wide_point_is_32_lane_values() {
     assert_eq!(
         std::mem::size_of::<WidePoint>(),
-        33 * std::mem::size_of::<W>()
+        32 * std::mem::size_of::<W>()
     );
     assert_eq!(std::mem::size_of::<WideRow>(), 7 * std::mem::size_of::<W>());
+}
+
+/// A wide constraint: 148 lane values (16 per constraint, 4 × 32 per point, the four points'
+/// relative velocities) and 80 bytes of `u32` lane indices, write flags and the point
+/// count — 2,448 bytes in f32 (2,512 with `usize` indices).
+#[test]
+fn a_wide_constraint_is_148_lane_values_and_80_bytes() {
+    let (w, align) = (std::mem::size_of::<W>(), std::mem::align_of::<W>());
+    let raw = 148 * w + 4 * 4 * 4 + 2 * 4 + std::mem::size_of::<usize>();
+    assert_eq!(raw, 148 * w + 80);
+    assert_eq!(
+        std::mem::size_of::<WideConstraint>(),
+        raw.div_ceil(align) * align
+    );
 }
