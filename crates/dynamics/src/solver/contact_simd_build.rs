@@ -10,7 +10,7 @@
 
 use super::{WideConstraint, WidePoint, WideRow, WideScratch, LANES, NONE, NO_SLOT, V3, W};
 use crate::contact::{ContactManifold, MAX_MANIFOLD_POINTS};
-use crate::solver::contact::ContactConstraint;
+use crate::solver::contact::{ContactConstraint, PointConstraint};
 use crate::solver::SolverBody;
 use carom_collision::math::{Mat3, Real, Vec3};
 use std::ops::Range;
@@ -46,32 +46,33 @@ fn get3(v: &V3, l: usize) -> Vec3 {
     Vec3::new(v.x.as_array()[l], v.y.as_array()[l], v.z.as_array()[l])
 }
 
-/// The inputs of the row build of one wide constraint that the lanes do not keep: the lever
-/// arms of every point and the inverse world inertias of every lane's bodies. Filled lane by
-/// lane ([`WideConstraint::set_lane`]) and consumed by [`WideConstraint::finish`].
+/// The inputs of the row build of one wide constraint that the lanes do not keep: the
+/// inverse world inertias of every lane's bodies, as nine lane vectors each (`m[c][r]`:
+/// column `c`, row `r`), written lane by lane ([`WideConstraint::set_lane`]) straight into
+/// that form and consumed by [`WideConstraint::finish`]. (The lever arms go straight into
+/// the points, which keep them.)
 pub(super) struct RowInputs {
-    arm_a: [V3; MAX_MANIFOLD_POINTS],
-    arm_b: [V3; MAX_MANIFOLD_POINTS],
-    inv_i_a: [Mat3; LANES],
-    inv_i_b: [Mat3; LANES],
+    inv_i_a: [[W; 3]; 3],
+    inv_i_b: [[W; 3]; 3],
 }
 
 impl Default for RowInputs {
     fn default() -> Self {
         RowInputs {
-            arm_a: [V3::default(); MAX_MANIFOLD_POINTS],
-            arm_b: [V3::default(); MAX_MANIFOLD_POINTS],
-            inv_i_a: [Mat3::ZERO; LANES],
-            inv_i_b: [Mat3::ZERO; LANES],
+            inv_i_a: [[W::default(); 3]; 3],
+            inv_i_b: [[W::default(); 3]; 3],
         }
     }
 }
 
-/// An inverse inertia of every lane, as nine lane vectors (`m[c][r]`: column `c`, row `r`).
+/// Sets lane `l` of the lane-form matrix `w` (`w[c][r]`: column `c`, row `r`) to `m`.
 #[inline(always)]
-fn wide_mat(m: &[Mat3; LANES]) -> [[W; 3]; 3] {
-    let e = |c: usize, r: usize| W::from(std::array::from_fn::<Real, LANES, _>(|l| m[l].col(c)[r]));
-    [0, 1, 2].map(|c| [0, 1, 2].map(|r| e(c, r)))
+fn put_mat(w: &mut [[W; 3]; 3], l: usize, m: &Mat3) {
+    for (wc, mc) in w.iter_mut().zip([m.x_axis, m.y_axis, m.z_axis]) {
+        put(&mut wc[0], l, mc.x);
+        put(&mut wc[1], l, mc.y);
+        put(&mut wc[2], l, mc.z);
+    }
 }
 
 /// `m * v` in every lane, in glam's order (`x_axis·v.x + y_axis·v.y + z_axis·v.z`, summed
@@ -98,29 +99,17 @@ fn keep(mask: W, v: V3) -> V3 {
 }
 
 impl WidePoint {
-    /// Lane `l` becomes point `k` of `c` but its rows (built by [`WideConstraint::finish`]),
-    /// or an empty point when `c` has fewer points.
+    /// Lane `l` becomes point `p` but its rows (built by [`WideConstraint::finish`]); an
+    /// absent point is [`PointConstraint::ZERO`].
     #[inline(always)]
-    fn set_lane(&mut self, l: usize, c: &ContactConstraint, k: usize) {
-        let p = (k < c.len).then(|| &c.points[k]);
-        let val = |f: fn(&super::super::contact::PointConstraint) -> Real| p.map_or(0.0, f);
-        put(&mut self.separation, l, val(|p| p.separation));
-        put(&mut self.normal_impulse, l, val(|p| p.normal_impulse));
-        put(
-            &mut self.tangent_impulse[0],
-            l,
-            val(|p| p.tangent_impulse[0]),
-        );
-        put(
-            &mut self.tangent_impulse[1],
-            l,
-            val(|p| p.tangent_impulse[1]),
-        );
-        put(
-            &mut self.max_normal_impulse,
-            l,
-            val(|p| p.max_normal_impulse),
-        );
+    fn set_lane(&mut self, l: usize, p: &PointConstraint) {
+        put3(&mut self.arm_a, l, p.arm_a);
+        put3(&mut self.arm_b, l, p.arm_b);
+        put(&mut self.separation, l, p.separation);
+        put(&mut self.normal_impulse, l, p.normal_impulse);
+        put(&mut self.tangent_impulse[0], l, p.tangent_impulse[0]);
+        put(&mut self.tangent_impulse[1], l, p.tangent_impulse[1]);
+        put(&mut self.max_normal_impulse, l, p.max_normal_impulse);
     }
 }
 
@@ -151,8 +140,8 @@ impl WideConstraint {
 
     /// Lane `l` becomes constraint `c` (whose bodies are `bodies[c.a]`, `bodies[c.b]`), or a
     /// padding lane (no points, no bodies) for `None`. Every field of the lane is written
-    /// but the rows and the points from `c.len` on; the lever arms and inverse inertias the
-    /// rows are built from go to `inputs` (zero past `c.len` and for padding).
+    /// but the rows and the points from `c.len` on (the points keep their lever arms); the
+    /// inverse inertias the rows are built from go to `inputs` (zero for padding).
     /// [`WideConstraint::finish`] completes the group.
     fn set_lane(
         &mut self,
@@ -174,8 +163,8 @@ impl WideConstraint {
         let (ba, bb) = (body(a), body(b));
         put(&mut self.inv_m_a, l, ba.map_or(0.0, |x| x.inv_m));
         put(&mut self.inv_m_b, l, bb.map_or(0.0, |x| x.inv_m));
-        inputs.inv_i_a[l] = ba.map_or(Mat3::ZERO, |x| x.inv_i);
-        inputs.inv_i_b[l] = bb.map_or(Mat3::ZERO, |x| x.inv_i);
+        put_mat(&mut inputs.inv_i_a, l, ba.map_or(&Mat3::ZERO, |x| &x.inv_i));
+        put_mat(&mut inputs.inv_i_b, l, bb.map_or(&Mat3::ZERO, |x| &x.inv_i));
         put3(&mut self.normal, l, c.normal);
         put3(&mut self.tangent[0], l, c.tangent[0]);
         put3(&mut self.tangent[1], l, c.tangent[1]);
@@ -184,18 +173,10 @@ impl WideConstraint {
         put(&mut self.bias_rate, l, c.softness.bias_rate);
         put(&mut self.mass_scale, l, c.softness.mass_scale);
         put(&mut self.impulse_scale, l, c.softness.impulse_scale);
-        for (k, wp) in self.points[..c.len].iter_mut().enumerate() {
-            wp.set_lane(l, c, k);
-            put(
-                &mut self.relative_velocity[k],
-                l,
-                c.points[k].relative_velocity,
-            );
-        }
-        for k in 0..MAX_MANIFOLD_POINTS {
-            let p = (k < c.len).then(|| &c.points[k]);
-            put3(&mut inputs.arm_a[k], l, p.map_or(Vec3::ZERO, |p| p.arm_a));
-            put3(&mut inputs.arm_b[k], l, p.map_or(Vec3::ZERO, |p| p.arm_b));
+        let points = self.points[..c.len].iter_mut().zip(&c.points);
+        for ((wp, p), v0) in points.zip(&mut self.relative_velocity) {
+            wp.set_lane(l, p);
+            put(v0, l, p.relative_velocity);
         }
     }
 
@@ -209,11 +190,11 @@ impl WideConstraint {
     fn finish(&mut self, inputs: &RowInputs) {
         for l in 0..LANES {
             for k in self.lens[l] as usize..self.len {
-                self.points[k].set_lane(l, &ContactConstraint::EMPTY, k);
+                self.points[k].set_lane(l, &PointConstraint::ZERO);
                 put(&mut self.relative_velocity[k], l, 0.0);
             }
         }
-        let (ia, ib) = (wide_mat(&inputs.inv_i_a), wide_mat(&inputs.inv_i_b));
+        let (ia, ib) = (&inputs.inv_i_a, &inputs.inv_i_b);
         let inv_m = self.inv_m_a + self.inv_m_b;
         let lens = W::from(std::array::from_fn::<Real, LANES, _>(|l| {
             self.lens[l] as Real
@@ -223,14 +204,12 @@ impl WideConstraint {
         for (k, p) in self.points[..self.len].iter_mut().enumerate() {
             let present = lens.simd_gt(W::splat(k as Real));
             let all_present = present.all();
-            let (ra, rb) = (inputs.arm_a[k], inputs.arm_b[k]);
-            // Zero in the lanes without the point (`set_lane` wrote zero arms there).
-            p.arm_a = ra;
-            p.arm_b = rb;
+            // Zero in the lanes without the point (zeroed above).
+            let (ra, rb) = (p.arm_a, p.arm_b);
             let [t0, t1] = &mut p.tangent_rows;
             for (row, d) in [&mut p.normal_row, t0, t1].into_iter().zip(dirs) {
                 let (ang_a, ang_b) = (ra.cross(d), rb.cross(d));
-                let (inv_ang_a, inv_ang_b) = (mat_mul(&ia, ang_a), mat_mul(&ib, ang_b));
+                let (inv_ang_a, inv_ang_b) = (mat_mul(ia, ang_a), mat_mul(ib, ang_b));
                 let k = inv_m + ang_a.dot(inv_ang_a) + ang_b.dot(inv_ang_b);
                 // `inv_or_zero`, and no mass for an absent point.
                 let mass = (k.simd_gt(eps) & present).select(one / k, zero);
