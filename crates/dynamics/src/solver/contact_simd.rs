@@ -218,7 +218,10 @@ pub(crate) struct WideConstraint {
     inv_m_a: W,
     inv_m_b: W,
     normal: V3,
-    tangent: [V3; 2],
+    /// The first tangent `t₀`; the second is `t₁ = n × t₀` (exactly how the preparation
+    /// builds it, so the lanes' [`WideConstraint::tangent1`] has the scalar constraint's
+    /// bits), recomputed once per pass instead of stored: 48 bytes less to stream.
+    tangent: V3,
     friction: W,
     restitution: W,
     bias_rate: W,
@@ -480,7 +483,7 @@ fn solve_parallel<F, A>(_: &mut [WideConstraint], _: Bodies, _: &F, _: &A) -> bo
 
 /// Warm start, as `contact::warm_start` in every lane.
 pub(crate) fn warm_start(c: &mut WideConstraint, a: &mut WideBody, b: &mut WideBody) {
-    let [tx, ty] = c.tangent;
+    let (tx, ty) = (c.tangent, c.tangent1());
     for p in &c.points[..c.len] {
         let (ni, [ti0, ti1]) = (p.normal_impulse, p.tangent_impulse);
         let imp = c.normal.scale(ni).add(tx.scale(ti0)).add(ty.scale(ti1));
@@ -508,6 +511,9 @@ pub(crate) fn warm_start(c: &mut WideConstraint, a: &mut WideBody, b: &mut WideB
 /// row 3 lane operations instead of 22 (the linear dot product and the two linear updates),
 /// and the body velocities and the frame leave the registers during the point loops.
 struct Linear {
+    /// The second tangent `t₁ = n × t₀` ([`WideConstraint::tangent1`]), computed once per
+    /// constraint and pass.
+    t1: V3,
     /// `n · (v_b − v_a)`, `t₀ · (v_b − v_a)`, `t₁ · (v_b − v_a)`.
     u: [W; 3],
     /// Sum of the impulse changes along `n`, `t₀`, `t₁`.
@@ -521,8 +527,10 @@ impl Linear {
     fn new(c: &WideConstraint, a: &WideBody, b: &WideBody) -> Linear {
         let dv = b.v.sub(a.v);
         let zero = W::splat(0.0);
+        let t1 = c.tangent1();
         Linear {
-            u: [c.normal.dot(dv), c.tangent[0].dot(dv), c.tangent[1].dot(dv)],
+            t1,
+            u: [c.normal.dot(dv), c.tangent.dot(dv), t1.dot(dv)],
             total: [zero; 3],
             inv_m: a.inv_m + b.inv_m,
         }
@@ -538,7 +546,7 @@ impl Linear {
     /// Applies the summed linear impulse to both bodies.
     #[inline(always)]
     fn finish(&self, c: &WideConstraint, a: &mut WideBody, b: &mut WideBody) {
-        let [t0, t1] = c.tangent;
+        let (t0, t1) = (c.tangent, self.t1);
         let imp = c
             .normal
             .scale(self.total[0])
@@ -553,7 +561,7 @@ impl Linear {
 #[inline(always)]
 fn solve_friction(c: &mut WideConstraint, a: &mut WideBody, b: &mut WideBody, lin: &mut Linear) {
     let one = W::splat(1.0);
-    let [t0, t1] = c.tangent;
+    let (t0, t1) = (c.tangent, lin.t1);
     for p in c.points[..c.len].iter_mut() {
         let (j0, j1) = (Angular::new(p, t0), Angular::new(p, t1));
         let [r0, r1] = &p.tangent_rows;
@@ -617,6 +625,16 @@ pub(crate) fn solve_soft(
         p.max_normal_impulse = p.max_normal_impulse.max(new);
     }
     lin.finish(c, a, b);
+}
+
+impl WideConstraint {
+    /// The second tangent of every lane, `t₁ = n × t₀`: the preparation's `n.cross(t1)`
+    /// with glam's order of operations ([`V3::cross`]), so the same bits as the scalar
+    /// constraint's `tangent[1]` (zero in padding lanes).
+    #[inline(always)]
+    fn tangent1(&self) -> V3 {
+        self.normal.cross(self.tangent)
+    }
 }
 
 /// Whether any lane has restitution: the restitution pass skips the others entirely, as

@@ -126,7 +126,7 @@ impl WideConstraint {
             inv_m_a: W::default(),
             inv_m_b: W::default(),
             normal: V3::default(),
-            tangent: [V3::default(); 2],
+            tangent: V3::default(),
             friction: W::default(),
             restitution: W::default(),
             bias_rate: W::default(),
@@ -166,8 +166,8 @@ impl WideConstraint {
         put_mat(&mut inputs.inv_i_a, l, ba.map_or(&Mat3::ZERO, |x| &x.inv_i));
         put_mat(&mut inputs.inv_i_b, l, bb.map_or(&Mat3::ZERO, |x| &x.inv_i));
         put3(&mut self.normal, l, c.normal);
-        put3(&mut self.tangent[0], l, c.tangent[0]);
-        put3(&mut self.tangent[1], l, c.tangent[1]);
+        put3(&mut self.tangent, l, c.tangent[0]);
+        debug_assert!(c.tangent[1] == c.normal.cross(c.tangent[0]));
         put(&mut self.friction, l, c.friction);
         put(&mut self.restitution, l, c.restitution);
         put(&mut self.bias_rate, l, c.softness.bias_rate);
@@ -200,7 +200,7 @@ impl WideConstraint {
             self.lens[l] as Real
         }));
         let (zero, one, eps) = (W::splat(0.0), W::splat(1.0), W::splat(Real::EPSILON));
-        let dirs = [self.normal, self.tangent[0], self.tangent[1]];
+        let dirs = [self.normal, self.tangent, self.tangent1()];
         for (k, p) in self.points[..self.len].iter_mut().enumerate() {
             let present = lens.simd_gt(W::splat(k as Real));
             let all_present = present.all();
@@ -421,7 +421,7 @@ pub(crate) unsafe fn store_range(
             let m_index = m_index as usize;
             assert!(m_index < len);
             let m = &mut *manifolds.add(m_index);
-            m.tangent = get3(&w.tangent[0], l);
+            m.tangent = get3(&w.tangent, l);
             for (out, wp) in m
                 .points_mut()
                 .iter_mut()

@@ -74,7 +74,9 @@ fn scene(rng: &mut Rng, count: usize) -> (Vec<SolverBody>, Vec<ContactConstraint
             bodies.len() - 1
         };
         let n = rng.vec(1.0).normalize();
-        let (t0, t1) = carom_collision::math::orthonormal_basis(n);
+        // The second tangent as the preparation builds it (the wide constraint recomputes it).
+        let t0 = carom_collision::math::orthonormal_basis(n).0;
+        let t1 = n.cross(t0);
         let len = 1 + (rng.next() * 4.0) as usize % MAX_MANIFOLD_POINTS;
         let mut points = [PointConstraint::default(); MAX_MANIFOLD_POINTS];
         for p in points.iter_mut().take(len) {
@@ -286,8 +288,8 @@ fn assert_lane(w: &WideConstraint, l: usize, c: Option<&ContactConstraint>, bodi
     assert_eq!(lane(&w.inv_m_a).to_bits(), inv_m(wa).to_bits());
     assert_eq!(lane(&w.inv_m_b).to_bits(), inv_m(wb).to_bits());
     assert_eq!(lane3(&w.normal), c_or.normal);
-    assert_eq!(lane3(&w.tangent[0]), c_or.tangent[0]);
-    assert_eq!(lane3(&w.tangent[1]), c_or.tangent[1]);
+    assert_eq!(lane3(&w.tangent), c_or.tangent[0]);
+    assert_eq!(lane3(&w.tangent1()), c_or.tangent[1]);
     assert_eq!(lane(&w.friction), c_or.friction);
     assert_eq!(lane(&w.restitution), c_or.restitution);
     assert_eq!(lane(&w.bias_rate), c_or.softness.bias_rate);
@@ -302,8 +304,8 @@ fn assert_lane(w: &WideConstraint, l: usize, c: Option<&ContactConstraint>, bodi
         };
         let rows = [
             (&wp.normal_row, &p.normal_row, w.normal),
-            (&wp.tangent_rows[0], &p.tangent_rows[0], w.tangent[0]),
-            (&wp.tangent_rows[1], &p.tangent_rows[1], w.tangent[1]),
+            (&wp.tangent_rows[0], &p.tangent_rows[0], w.tangent),
+            (&wp.tangent_rows[1], &p.tangent_rows[1], w.tangent1()),
         ];
         assert_eq!(lane3(&wp.arm_a), p.arm_a);
         assert_eq!(lane3(&wp.arm_b), p.arm_b);
@@ -540,14 +542,15 @@ fn a_wide_point_is_32_lane_values() {
     assert_eq!(std::mem::size_of::<WideRow>(), 7 * std::mem::size_of::<W>());
 }
 
-/// A wide constraint: 148 lane values (16 per constraint, 4 × 32 per point, the four points'
-/// relative velocities) and 80 bytes of `u32` lane indices, write flags and the point
-/// count — 2,448 bytes in f32 (2,512 with `usize` indices).
+/// A wide constraint: 145 lane values (13 per constraint — the second tangent is
+/// recomputed —, 4 × 32 per point, the four points' relative velocities) and 80 bytes of
+/// `u32` lane indices, write flags and the point count — 2,400 bytes in f32 (2,512 with
+/// `usize` indices, a stored second tangent and the relative velocity in the points).
 #[test]
-fn a_wide_constraint_is_148_lane_values_and_80_bytes() {
+fn a_wide_constraint_is_145_lane_values_and_80_bytes() {
     let (w, align) = (std::mem::size_of::<W>(), std::mem::align_of::<W>());
-    let raw = 148 * w + 4 * 4 * 4 + 2 * 4 + std::mem::size_of::<usize>();
-    assert_eq!(raw, 148 * w + 80);
+    let raw = 145 * w + 4 * 4 * 4 + 2 * 4 + std::mem::size_of::<usize>();
+    assert_eq!(raw, 145 * w + 80);
     assert_eq!(
         std::mem::size_of::<WideConstraint>(),
         raw.div_ceil(align) * align
