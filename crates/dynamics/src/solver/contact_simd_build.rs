@@ -51,18 +51,10 @@ fn get3(v: &V3, l: usize) -> Vec3 {
 /// column `c`, row `r`), written lane by lane ([`WideConstraint::set_lane`]) straight into
 /// that form and consumed by [`WideConstraint::finish`]. (The lever arms go straight into
 /// the points, which keep them.)
+#[derive(Default)]
 pub(super) struct RowInputs {
     inv_i_a: [[W; 3]; 3],
     inv_i_b: [[W; 3]; 3],
-}
-
-impl Default for RowInputs {
-    fn default() -> Self {
-        RowInputs {
-            inv_i_a: [[W::default(); 3]; 3],
-            inv_i_b: [[W::default(); 3]; 3],
-        }
-    }
 }
 
 /// Sets lane `l` of the lane-form matrix `w` (`w[c][r]`: column `c`, row `r`) to `m`.
