@@ -53,8 +53,12 @@ pub(crate) type W = <Real as Lanes>::W;
 /// Lanes per wide constraint.
 pub(crate) const LANES: usize = 4;
 
-/// Lane body slot of a padding lane.
+/// Colour-order index of a padding lane in [`WideScratch::members`].
 const NONE: usize = usize::MAX;
+
+/// Body slot, manifold index of a padding lane in a [`WideConstraint`] (whose indices are
+/// `u32`: half the bytes of `usize`, and slots and manifold indices stay far below 2³²).
+const NO_SLOT: u32 = u32::MAX;
 
 /// A vector of four lanes of [`Vec3`](carom_collision::math::Vec3).
 #[derive(Debug, Clone, Copy, Default)]
@@ -89,6 +93,16 @@ impl V3 {
         }
     }
 
+    /// `self × o` in glam's order of operations (`Vec3::cross`).
+    #[inline(always)]
+    fn cross(self, o: V3) -> V3 {
+        V3 {
+            x: self.y * o.z - o.y * self.z,
+            y: self.z * o.x - o.z * self.x,
+            z: self.x * o.y - o.x * self.y,
+        }
+    }
+
     #[inline(always)]
     fn scale(self, s: W) -> V3 {
         V3 {
@@ -99,21 +113,41 @@ impl V3 {
     }
 }
 
-/// Four [`super::contact::ContactRow`]s.
+/// The stored half of four [`super::contact::ContactRow`]s: the angular impulse directions
+/// premultiplied by the inverse world inertias and the effective mass. The angular
+/// Jacobians `r × d` themselves are not stored: each pass recomputes them from the point's
+/// lever arms ([`WidePoint::arm_a`], shared by the normal and both tangent rows), as Box2D v3
+/// recomputes its Jacobians from the anchors (`b2ContactConstraintSIMD` keeps anchors, not
+/// Jacobians). Same operations as the scalar `ContactRow::new`, so the same bits.
 #[derive(Debug, Clone, Copy, Default)]
 struct WideRow {
-    ang_a: V3,
-    ang_b: V3,
     inv_ang_a: V3,
     inv_ang_b: V3,
     mass: W,
 }
 
-impl WideRow {
+/// The angular Jacobians `r_a × d`, `r_b × d` of one row of four points, recomputed from the
+/// lever arms in each pass (see [`WideRow`]).
+#[derive(Clone, Copy)]
+struct Angular {
+    a: V3,
+    b: V3,
+}
+
+impl Angular {
+    /// `(r_a × d, r_b × d)` in glam's order of operations (the bits of `Vec3::cross`).
+    #[inline(always)]
+    fn new(p: &WidePoint, d: V3) -> Angular {
+        Angular {
+            a: p.arm_a.cross(d),
+            b: p.arm_b.cross(d),
+        }
+    }
+
     /// `J v`, as `ContactRow::velocity`.
     #[inline(always)]
     fn velocity(&self, d: V3, a: &WideBody, b: &WideBody) -> W {
-        d.dot(b.v.sub(a.v)) + self.ang_b.dot(b.w) - self.ang_a.dot(a.w)
+        d.dot(b.v.sub(a.v)) + self.b.dot(b.w) - self.a.dot(a.w)
     }
 
     /// `J Δx`, as `ContactRow::displacement`, given its linear part `d · (Δx_b − Δx_a)`
@@ -121,16 +155,18 @@ impl WideRow {
     /// a pass, so the solve computes it once per constraint).
     #[inline(always)]
     fn displacement(&self, linear: W, a: &WideBody, b: &WideBody) -> W {
-        linear + self.ang_b.dot(b.dq) - self.ang_a.dot(a.dq)
+        linear + self.b.dot(b.dq) - self.a.dot(a.dq)
     }
 
     /// `J v` given its linear part `u = d · (v_b − v_a)`, which the solve tracks per
     /// constraint and direction (see [`solve_soft`]).
     #[inline(always)]
     fn velocity_from(&self, u: W, a: &WideBody, b: &WideBody) -> W {
-        u + self.ang_b.dot(b.w) - self.ang_a.dot(a.w)
+        u + self.b.dot(b.w) - self.a.dot(a.w)
     }
+}
 
+impl WideRow {
     /// The angular half of [`WideRow::apply`]; the linear half is applied once per
     /// constraint (see [`solve_soft`]).
     #[inline(always)]
@@ -152,10 +188,13 @@ impl WideRow {
 /// Point `k` of four constraints (zero rows in lanes with fewer points).
 #[derive(Debug, Clone, Copy, Default)]
 struct WidePoint {
+    /// Lever arms of the point from the centres of mass of A and B (zero in lanes without
+    /// the point).
+    arm_a: V3,
+    arm_b: V3,
     normal_row: WideRow,
     tangent_rows: [WideRow; 2],
     separation: W,
-    relative_velocity: W,
     normal_impulse: W,
     tangent_impulse: [W; 2],
     max_normal_impulse: W,
@@ -165,21 +204,24 @@ struct WidePoint {
 /// `b2ContactConstraintSIMD`).
 #[derive(Debug, Clone)]
 pub(crate) struct WideConstraint {
-    /// Body slots of each lane (`NONE` for padding).
-    a: [usize; LANES],
-    b: [usize; LANES],
+    /// Body slots of each lane (`NO_SLOT` for padding).
+    a: [u32; LANES],
+    b: [u32; LANES],
     /// Whether the solve writes the lane's body back (dynamic bodies only: a static or
     /// kinematic body may be shared by several lanes and threads, and is only read).
     write_a: [bool; LANES],
     write_b: [bool; LANES],
-    /// Manifold of each lane (`NONE` for padding), where `store` writes the impulses.
-    manifold: [usize; LANES],
+    /// Manifold of each lane (`NO_SLOT` for padding), where `store` writes the impulses.
+    manifold: [u32; LANES],
     /// Point count of each lane.
-    lens: [usize; LANES],
+    lens: [u32; LANES],
     inv_m_a: W,
     inv_m_b: W,
     normal: V3,
-    tangent: [V3; 2],
+    /// The first tangent `t₀`; the second is `t₁ = n × t₀` (exactly how the preparation
+    /// builds it, so the lanes' [`WideConstraint::tangent1`] has the scalar constraint's
+    /// bits), recomputed once per pass instead of stored: 48 bytes less to stream.
+    tangent: V3,
     friction: W,
     restitution: W,
     bias_rate: W,
@@ -188,6 +230,10 @@ pub(crate) struct WideConstraint {
     points: [WidePoint; MAX_MANIFOLD_POINTS],
     /// Largest point count of the lanes.
     len: usize,
+    /// Normal relative velocity of each point at preparation, read only by the restitution
+    /// pass: kept out of [`WidePoint`], so the points the solve, relax and warm-start passes
+    /// stream are 32 lane values (512 bytes, eight cache lines) instead of 33.
+    relative_velocity: [W; MAX_MANIFOLD_POINTS],
 }
 
 /// The velocities and position deltas of four bodies (Box2D v3's `b2BodyStateW`).
@@ -205,12 +251,12 @@ pub(crate) struct WideBody {
 /// ([`SolverBody::state`]), read as three four-wide rows and transposed with three 4×4
 /// transposes, which leave exactly the twelve lane vectors (`v.x … dq.z`).
 #[inline(always)]
-fn gather(bodies: &[SolverBody], slots: &[usize; LANES], inv_m: W) -> WideBody {
-    let row = |s: usize| {
-        if s == NONE {
+fn gather(bodies: &[SolverBody], slots: &[u32; LANES], inv_m: W) -> WideBody {
+    let row = |s: u32| {
+        if s == NO_SLOT {
             [[0.0; LANES]; 3]
         } else {
-            bodies[s].state()
+            bodies[s as usize].state()
         }
     };
     // Not `slots.map`: that call was left out of line in the stage executor (module
@@ -255,7 +301,7 @@ unsafe fn scatter(
     body: &WideBody,
     bodies: *mut SolverBody,
     len: usize,
-    slots: &[usize; LANES],
+    slots: &[u32; LANES],
     write: &[bool; LANES],
 ) {
     let r0 = W::transpose([body.v.x, body.v.y, body.v.z, body.w.x]);
@@ -264,7 +310,7 @@ unsafe fn scatter(
         if !write[l] {
             continue;
         }
-        let s = slots[l];
+        let s = slots[l] as usize;
         assert!(s < len);
         let target = &mut *bodies.add(s);
         target.set_velocities(r0[l].to_array(), r1[l].to_array());
@@ -437,7 +483,7 @@ fn solve_parallel<F, A>(_: &mut [WideConstraint], _: Bodies, _: &F, _: &A) -> bo
 
 /// Warm start, as `contact::warm_start` in every lane.
 pub(crate) fn warm_start(c: &mut WideConstraint, a: &mut WideBody, b: &mut WideBody) {
-    let [tx, ty] = c.tangent;
+    let (tx, ty) = (c.tangent, c.tangent1());
     for p in &c.points[..c.len] {
         let (ni, [ti0, ti1]) = (p.normal_impulse, p.tangent_impulse);
         let imp = c.normal.scale(ni).add(tx.scale(ti0)).add(ty.scale(ti1));
@@ -465,6 +511,9 @@ pub(crate) fn warm_start(c: &mut WideConstraint, a: &mut WideBody, b: &mut WideB
 /// row 3 lane operations instead of 22 (the linear dot product and the two linear updates),
 /// and the body velocities and the frame leave the registers during the point loops.
 struct Linear {
+    /// The second tangent `t₁ = n × t₀` ([`WideConstraint::tangent1`]), computed once per
+    /// constraint and pass.
+    t1: V3,
     /// `n · (v_b − v_a)`, `t₀ · (v_b − v_a)`, `t₁ · (v_b − v_a)`.
     u: [W; 3],
     /// Sum of the impulse changes along `n`, `t₀`, `t₁`.
@@ -478,8 +527,10 @@ impl Linear {
     fn new(c: &WideConstraint, a: &WideBody, b: &WideBody) -> Linear {
         let dv = b.v.sub(a.v);
         let zero = W::splat(0.0);
+        let t1 = c.tangent1();
         Linear {
-            u: [c.normal.dot(dv), c.tangent[0].dot(dv), c.tangent[1].dot(dv)],
+            t1,
+            u: [c.normal.dot(dv), c.tangent.dot(dv), t1.dot(dv)],
             total: [zero; 3],
             inv_m: a.inv_m + b.inv_m,
         }
@@ -495,7 +546,7 @@ impl Linear {
     /// Applies the summed linear impulse to both bodies.
     #[inline(always)]
     fn finish(&self, c: &WideConstraint, a: &mut WideBody, b: &mut WideBody) {
-        let [t0, t1] = c.tangent;
+        let (t0, t1) = (c.tangent, self.t1);
         let imp = c
             .normal
             .scale(self.total[0])
@@ -510,12 +561,14 @@ impl Linear {
 #[inline(always)]
 fn solve_friction(c: &mut WideConstraint, a: &mut WideBody, b: &mut WideBody, lin: &mut Linear) {
     let one = W::splat(1.0);
+    let (t0, t1) = (c.tangent, lin.t1);
     for p in c.points[..c.len].iter_mut() {
+        let (j0, j1) = (Angular::new(p, t0), Angular::new(p, t1));
         let [r0, r1] = &p.tangent_rows;
         let old = p.tangent_impulse;
         let new = [
-            old[0] - r0.mass * r0.velocity_from(lin.u[1], a, b),
-            old[1] - r1.mass * r1.velocity_from(lin.u[2], a, b),
+            old[0] - r0.mass * j0.velocity_from(lin.u[1], a, b),
+            old[1] - r1.mass * j1.velocity_from(lin.u[2], a, b),
         ];
         let max = c.friction * p.normal_impulse;
         let len_sq = new[0] * new[0] + new[1] * new[1];
@@ -550,7 +603,8 @@ pub(crate) fn solve_soft(
     let linear = n.dot(b.dp.sub(a.dp));
     for p in c.points[..c.len].iter_mut() {
         let row = &p.normal_row;
-        let s = p.separation + row.displacement(linear, a, b);
+        let j = Angular::new(p, n);
+        let s = p.separation + j.displacement(linear, a, b);
         let gap = s.simd_gt(zero);
         let (bias, mass_scale, impulse_scale) = if use_bias {
             (
@@ -561,7 +615,7 @@ pub(crate) fn solve_soft(
         } else {
             (gap.select(s * inv_h, zero), one, zero)
         };
-        let vn = row.velocity_from(lin.u[0], a, b);
+        let vn = j.velocity_from(lin.u[0], a, b);
         let lambda = -row.mass * mass_scale * (vn + bias) - impulse_scale * p.normal_impulse;
         let new = (p.normal_impulse + lambda).max(zero);
         let d = new - p.normal_impulse;
@@ -571,6 +625,16 @@ pub(crate) fn solve_soft(
         p.max_normal_impulse = p.max_normal_impulse.max(new);
     }
     lin.finish(c, a, b);
+}
+
+impl WideConstraint {
+    /// The second tangent of every lane, `t₁ = n × t₀`: the preparation's `n.cross(t1)`
+    /// with glam's order of operations ([`V3::cross`]), so the same bits as the scalar
+    /// constraint's `tangent[1]` (zero in padding lanes).
+    #[inline(always)]
+    fn tangent1(&self) -> V3 {
+        self.normal.cross(self.tangent)
+    }
 }
 
 /// Whether any lane has restitution: the restitution pass skips the others entirely, as
@@ -592,12 +656,12 @@ pub(crate) fn apply_restitution(
     let threshold = W::splat(-threshold);
     let bouncy = !c.restitution.simd_eq(zero);
     let n = c.normal;
-    for p in c.points[..c.len].iter_mut() {
-        let skip = p.relative_velocity.simd_gt(threshold) | p.max_normal_impulse.simd_eq(zero);
+    for (p, &v0) in c.points[..c.len].iter_mut().zip(&c.relative_velocity) {
+        let skip = v0.simd_gt(threshold) | p.max_normal_impulse.simd_eq(zero);
         let active = bouncy & !skip;
         let row = &p.normal_row;
-        let vn = row.velocity(n, a, b);
-        let lambda = -row.mass * (vn + c.restitution * p.relative_velocity);
+        let vn = Angular::new(p, n).velocity(n, a, b);
+        let lambda = -row.mass * (vn + c.restitution * v0);
         let new = active.select((p.normal_impulse + lambda).max(zero), p.normal_impulse);
         row.apply(n, new - p.normal_impulse, a, b);
         p.normal_impulse = new;

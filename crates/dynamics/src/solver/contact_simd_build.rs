@@ -8,9 +8,9 @@
 //! neither zeroes nor copies the (large) constraint arrays. Box2D v3 prepares its SIMD constraints the same way
 //! (`b2PrepareContactsTask` writes `b2ContactConstraintSIMD` lanes directly).
 
-use super::{WideConstraint, WidePoint, WideRow, WideScratch, LANES, NONE, V3, W};
+use super::{WideConstraint, WidePoint, WideRow, WideScratch, LANES, NONE, NO_SLOT, V3, W};
 use crate::contact::{ContactManifold, MAX_MANIFOLD_POINTS};
-use crate::solver::contact::ContactConstraint;
+use crate::solver::contact::{ContactConstraint, PointConstraint};
 use crate::solver::SolverBody;
 use carom_collision::math::{Mat3, Real, Vec3};
 use std::ops::Range;
@@ -29,38 +29,42 @@ fn put3(v: &mut V3, l: usize, x: Vec3) {
     put(&mut v.z, l, x.z);
 }
 
+/// `x` as a lane index of a [`WideConstraint`] (body slot, manifold index).
+#[inline(always)]
+fn lane_index(x: usize) -> u32 {
+    let i = u32::try_from(x).unwrap_or(NO_SLOT);
+    assert!(
+        i != NO_SLOT,
+        "index {x} does not fit a wide constraint's u32 lane index"
+    );
+    i
+}
+
 /// Lane `l` of `v`.
 #[inline(always)]
 fn get3(v: &V3, l: usize) -> Vec3 {
     Vec3::new(v.x.as_array()[l], v.y.as_array()[l], v.z.as_array()[l])
 }
 
-/// The inputs of the row build of one wide constraint that the lanes do not keep: the lever
-/// arms of every point and the inverse world inertias of every lane's bodies. Filled lane by
-/// lane ([`WideConstraint::set_lane`]) and consumed by [`WideConstraint::finish`].
+/// The inputs of the row build of one wide constraint that the lanes do not keep: the
+/// inverse world inertias of every lane's bodies, as nine lane vectors each (`m[c][r]`:
+/// column `c`, row `r`), written lane by lane ([`WideConstraint::set_lane`]) straight into
+/// that form and consumed by [`WideConstraint::finish`]. (The lever arms go straight into
+/// the points, which keep them.)
+#[derive(Default)]
 pub(super) struct RowInputs {
-    arm_a: [V3; MAX_MANIFOLD_POINTS],
-    arm_b: [V3; MAX_MANIFOLD_POINTS],
-    inv_i_a: [Mat3; LANES],
-    inv_i_b: [Mat3; LANES],
+    inv_i_a: [[W; 3]; 3],
+    inv_i_b: [[W; 3]; 3],
 }
 
-impl Default for RowInputs {
-    fn default() -> Self {
-        RowInputs {
-            arm_a: [V3::default(); MAX_MANIFOLD_POINTS],
-            arm_b: [V3::default(); MAX_MANIFOLD_POINTS],
-            inv_i_a: [Mat3::ZERO; LANES],
-            inv_i_b: [Mat3::ZERO; LANES],
-        }
-    }
-}
-
-/// An inverse inertia of every lane, as nine lane vectors (`m[c][r]`: column `c`, row `r`).
+/// Sets lane `l` of the lane-form matrix `w` (`w[c][r]`: column `c`, row `r`) to `m`.
 #[inline(always)]
-fn wide_mat(m: &[Mat3; LANES]) -> [[W; 3]; 3] {
-    let e = |c: usize, r: usize| W::from(std::array::from_fn::<Real, LANES, _>(|l| m[l].col(c)[r]));
-    [0, 1, 2].map(|c| [0, 1, 2].map(|r| e(c, r)))
+fn put_mat(w: &mut [[W; 3]; 3], l: usize, m: &Mat3) {
+    for (wc, mc) in w.iter_mut().zip([m.x_axis, m.y_axis, m.z_axis]) {
+        put(&mut wc[0], l, mc.x);
+        put(&mut wc[1], l, mc.y);
+        put(&mut wc[2], l, mc.z);
+    }
 }
 
 /// `m * v` in every lane, in glam's order (`x_axis·v.x + y_axis·v.y + z_axis·v.z`, summed
@@ -72,16 +76,6 @@ fn mat_mul(m: &[[W; 3]; 3], v: V3) -> V3 {
         x: r(0),
         y: r(1),
         z: r(2),
-    }
-}
-
-/// `a × b` in every lane, in glam's order.
-#[inline(always)]
-fn cross(a: V3, b: V3) -> V3 {
-    V3 {
-        x: a.y * b.z - b.y * a.z,
-        y: a.z * b.x - b.z * a.x,
-        z: a.x * b.y - b.x * a.y,
     }
 }
 
@@ -97,30 +91,17 @@ fn keep(mask: W, v: V3) -> V3 {
 }
 
 impl WidePoint {
-    /// Lane `l` becomes point `k` of `c` but its rows (built by [`WideConstraint::finish`]),
-    /// or an empty point when `c` has fewer points.
+    /// Lane `l` becomes point `p` but its rows (built by [`WideConstraint::finish`]); an
+    /// absent point is [`PointConstraint::ZERO`].
     #[inline(always)]
-    fn set_lane(&mut self, l: usize, c: &ContactConstraint, k: usize) {
-        let p = (k < c.len).then(|| &c.points[k]);
-        let val = |f: fn(&super::super::contact::PointConstraint) -> Real| p.map_or(0.0, f);
-        put(&mut self.separation, l, val(|p| p.separation));
-        put(&mut self.relative_velocity, l, val(|p| p.relative_velocity));
-        put(&mut self.normal_impulse, l, val(|p| p.normal_impulse));
-        put(
-            &mut self.tangent_impulse[0],
-            l,
-            val(|p| p.tangent_impulse[0]),
-        );
-        put(
-            &mut self.tangent_impulse[1],
-            l,
-            val(|p| p.tangent_impulse[1]),
-        );
-        put(
-            &mut self.max_normal_impulse,
-            l,
-            val(|p| p.max_normal_impulse),
-        );
+    fn set_lane(&mut self, l: usize, p: &PointConstraint) {
+        put3(&mut self.arm_a, l, p.arm_a);
+        put3(&mut self.arm_b, l, p.arm_b);
+        put(&mut self.separation, l, p.separation);
+        put(&mut self.normal_impulse, l, p.normal_impulse);
+        put(&mut self.tangent_impulse[0], l, p.tangent_impulse[0]);
+        put(&mut self.tangent_impulse[1], l, p.tangent_impulse[1]);
+        put(&mut self.max_normal_impulse, l, p.max_normal_impulse);
     }
 }
 
@@ -128,16 +109,16 @@ impl WideConstraint {
     /// A constraint with four padding lanes.
     pub(super) fn empty() -> Self {
         WideConstraint {
-            a: [NONE; LANES],
-            b: [NONE; LANES],
+            a: [NO_SLOT; LANES],
+            b: [NO_SLOT; LANES],
             write_a: [false; LANES],
             write_b: [false; LANES],
-            manifold: [NONE; LANES],
+            manifold: [NO_SLOT; LANES],
             lens: [0; LANES],
             inv_m_a: W::default(),
             inv_m_b: W::default(),
             normal: V3::default(),
-            tangent: [V3::default(); 2],
+            tangent: V3::default(),
             friction: W::default(),
             restitution: W::default(),
             bias_rate: W::default(),
@@ -145,13 +126,14 @@ impl WideConstraint {
             impulse_scale: W::default(),
             points: [WidePoint::default(); MAX_MANIFOLD_POINTS],
             len: 0,
+            relative_velocity: [W::default(); MAX_MANIFOLD_POINTS],
         }
     }
 
     /// Lane `l` becomes constraint `c` (whose bodies are `bodies[c.a]`, `bodies[c.b]`), or a
     /// padding lane (no points, no bodies) for `None`. Every field of the lane is written
-    /// but the rows and the points from `c.len` on; the lever arms and inverse inertias the
-    /// rows are built from go to `inputs` (zero past `c.len` and for padding).
+    /// but the rows and the points from `c.len` on (the points keep their lever arms); the
+    /// inverse inertias the rows are built from go to `inputs` (zero for padding).
     /// [`WideConstraint::finish`] completes the group.
     fn set_lane(
         &mut self,
@@ -163,33 +145,30 @@ impl WideConstraint {
         let c = c.unwrap_or(&ContactConstraint::EMPTY);
         let pad = c.len == 0;
         let (a, b) = if pad { (NONE, NONE) } else { (c.a, c.b) };
-        self.a[l] = a;
-        self.b[l] = b;
+        self.a[l] = if pad { NO_SLOT } else { lane_index(a) };
+        self.b[l] = if pad { NO_SLOT } else { lane_index(b) };
         self.write_a[l] = !pad && bodies[a].dynamic;
         self.write_b[l] = !pad && bodies[b].dynamic;
-        self.manifold[l] = if pad { NONE } else { c.manifold };
-        self.lens[l] = c.len;
+        self.manifold[l] = if pad { NO_SLOT } else { lane_index(c.manifold) };
+        self.lens[l] = c.len as u32;
         let body = |s: usize| (!pad).then(|| &bodies[s]);
         let (ba, bb) = (body(a), body(b));
         put(&mut self.inv_m_a, l, ba.map_or(0.0, |x| x.inv_m));
         put(&mut self.inv_m_b, l, bb.map_or(0.0, |x| x.inv_m));
-        inputs.inv_i_a[l] = ba.map_or(Mat3::ZERO, |x| x.inv_i);
-        inputs.inv_i_b[l] = bb.map_or(Mat3::ZERO, |x| x.inv_i);
+        put_mat(&mut inputs.inv_i_a, l, ba.map_or(&Mat3::ZERO, |x| &x.inv_i));
+        put_mat(&mut inputs.inv_i_b, l, bb.map_or(&Mat3::ZERO, |x| &x.inv_i));
         put3(&mut self.normal, l, c.normal);
-        put3(&mut self.tangent[0], l, c.tangent[0]);
-        put3(&mut self.tangent[1], l, c.tangent[1]);
+        put3(&mut self.tangent, l, c.tangent[0]);
+        debug_assert!(c.tangent[1] == c.normal.cross(c.tangent[0]));
         put(&mut self.friction, l, c.friction);
         put(&mut self.restitution, l, c.restitution);
         put(&mut self.bias_rate, l, c.softness.bias_rate);
         put(&mut self.mass_scale, l, c.softness.mass_scale);
         put(&mut self.impulse_scale, l, c.softness.impulse_scale);
-        for (k, wp) in self.points[..c.len].iter_mut().enumerate() {
-            wp.set_lane(l, c, k);
-        }
-        for k in 0..MAX_MANIFOLD_POINTS {
-            let p = (k < c.len).then(|| &c.points[k]);
-            put3(&mut inputs.arm_a[k], l, p.map_or(Vec3::ZERO, |p| p.arm_a));
-            put3(&mut inputs.arm_b[k], l, p.map_or(Vec3::ZERO, |p| p.arm_b));
+        let points = self.points[..c.len].iter_mut().zip(&c.points);
+        for ((wp, p), v0) in points.zip(&mut self.relative_velocity) {
+            wp.set_lane(l, p);
+            put(v0, l, p.relative_velocity);
         }
     }
 
@@ -202,42 +181,43 @@ impl WideConstraint {
     /// length, and a group of one-point lanes builds one point instead of four.
     fn finish(&mut self, inputs: &RowInputs) {
         for l in 0..LANES {
-            for k in self.lens[l]..self.len {
-                self.points[k].set_lane(l, &ContactConstraint::EMPTY, k);
+            for k in self.lens[l] as usize..self.len {
+                self.points[k].set_lane(l, &PointConstraint::ZERO);
+                put(&mut self.relative_velocity[k], l, 0.0);
             }
         }
-        let (ia, ib) = (wide_mat(&inputs.inv_i_a), wide_mat(&inputs.inv_i_b));
+        let (ia, ib) = (&inputs.inv_i_a, &inputs.inv_i_b);
         let inv_m = self.inv_m_a + self.inv_m_b;
         let lens = W::from(std::array::from_fn::<Real, LANES, _>(|l| {
             self.lens[l] as Real
         }));
         let (zero, one, eps) = (W::splat(0.0), W::splat(1.0), W::splat(Real::EPSILON));
-        let dirs = [self.normal, self.tangent[0], self.tangent[1]];
+        let dirs = [self.normal, self.tangent, self.tangent1()];
         for (k, p) in self.points[..self.len].iter_mut().enumerate() {
             let present = lens.simd_gt(W::splat(k as Real));
             let all_present = present.all();
-            let (ra, rb) = (inputs.arm_a[k], inputs.arm_b[k]);
+            // Zero in the lanes without the point (zeroed above).
+            let (ra, rb) = (p.arm_a, p.arm_b);
             let [t0, t1] = &mut p.tangent_rows;
             for (row, d) in [&mut p.normal_row, t0, t1].into_iter().zip(dirs) {
-                let (ang_a, ang_b) = (cross(ra, d), cross(rb, d));
-                let (inv_ang_a, inv_ang_b) = (mat_mul(&ia, ang_a), mat_mul(&ib, ang_b));
+                let (ang_a, ang_b) = (ra.cross(d), rb.cross(d));
+                let (inv_ang_a, inv_ang_b) = (mat_mul(ia, ang_a), mat_mul(ib, ang_b));
                 let k = inv_m + ang_a.dot(inv_ang_a) + ang_b.dot(inv_ang_b);
                 // `inv_or_zero`, and no mass for an absent point.
                 let mass = (k.simd_gt(eps) & present).select(one / k, zero);
                 *row = if all_present {
                     WideRow {
-                        ang_a,
-                        ang_b,
                         inv_ang_a,
                         inv_ang_b,
                         mass,
                     }
                 } else {
                     // Zero rows (not `-0.0` from `0 × d`) in the absent lanes, as a scalar
-                    // `ContactRow::ZERO`.
+                    // `ContactRow::ZERO`. The solve recomputes `r × d` from the zero arms
+                    // there, which may give `-0.0`; it only meets the zero mass and the
+                    // zero impulse of the lane, so the impulse change stays `+0.0` and the
+                    // `+0.0` rows here leave the bodies' bits alone.
                     WideRow {
-                        ang_a: keep(present, ang_a),
-                        ang_b: keep(present, ang_b),
                         inv_ang_a: keep(present, inv_ang_a),
                         inv_ang_b: keep(present, inv_ang_b),
                         mass,
@@ -427,13 +407,18 @@ pub(crate) unsafe fn store_range(
         let w = &*cons.add(i);
         for l in 0..LANES {
             let m_index = w.manifold[l];
-            if m_index == NONE {
+            if m_index == NO_SLOT {
                 continue;
             }
+            let m_index = m_index as usize;
             assert!(m_index < len);
             let m = &mut *manifolds.add(m_index);
-            m.tangent = get3(&w.tangent[0], l);
-            for (out, wp) in m.points_mut().iter_mut().zip(&w.points[..w.lens[l]]) {
+            m.tangent = get3(&w.tangent, l);
+            for (out, wp) in m
+                .points_mut()
+                .iter_mut()
+                .zip(&w.points[..w.lens[l] as usize])
+            {
                 out.normal_impulse = wp.normal_impulse.as_array()[l] * scale;
                 out.tangent_impulse = [
                     wp.tangent_impulse[0].as_array()[l] * scale,
@@ -450,7 +435,10 @@ pub(crate) unsafe fn store_range(
 pub(crate) fn write_back(wide: &WideScratch, cons: &mut [ContactConstraint]) {
     for w in &wide.cons {
         for l in 0..LANES {
-            let Some(c) = cons.iter_mut().find(|c| c.manifold == w.manifold[l]) else {
+            let Some(c) = cons
+                .iter_mut()
+                .find(|c| w.manifold[l] != NO_SLOT && c.manifold == w.manifold[l] as usize)
+            else {
                 continue;
             };
             for (k, p) in c.points[..c.len].iter_mut().enumerate() {

@@ -74,7 +74,9 @@ fn scene(rng: &mut Rng, count: usize) -> (Vec<SolverBody>, Vec<ContactConstraint
             bodies.len() - 1
         };
         let n = rng.vec(1.0).normalize();
-        let (t0, t1) = carom_collision::math::orthonormal_basis(n);
+        // The second tangent as the preparation builds it (the wide constraint recomputes it).
+        let t0 = carom_collision::math::orthonormal_basis(n).0;
+        let t1 = n.cross(t0);
         let len = 1 + (rng.next() * 4.0) as usize % MAX_MANIFOLD_POINTS;
         let mut points = [PointConstraint::default(); MAX_MANIFOLD_POINTS];
         for p in points.iter_mut().take(len) {
@@ -204,9 +206,40 @@ fn wide_solve_equals_scalar_solves() {
             );
             write_back(&wide, &mut cons);
             compare(&bodies, &bodies2, &cons, &cons2);
+            same_bits(&bodies, &bodies2, &cons, &cons2);
         }
         // Static body never written.
         assert_eq!(bodies[0], bodies2[0]);
+    }
+}
+
+/// The wide passes recompute the rows' `r × d` from the lever arms in the scalar order, so
+/// they give the scalar routines' velocities and impulses bit for bit, not only to
+/// round-off.
+fn same_bits(
+    bodies: &[SolverBody],
+    bodies2: &[SolverBody],
+    cons: &[ContactConstraint],
+    cons2: &[ContactConstraint],
+) {
+    let bits = |v: Vec3| v.to_array().map(|x| x.to_bits());
+    for (i, (x, y)) in bodies.iter().zip(bodies2).enumerate() {
+        assert_eq!(bits(x.v), bits(y.v), "body {i} v");
+        assert_eq!(bits(x.w), bits(y.w), "body {i} w");
+    }
+    for (c, d) in cons.iter().zip(cons2) {
+        for (p, q) in c.points[..c.len].iter().zip(&d.points[..d.len]) {
+            let imp = |p: &PointConstraint| {
+                [
+                    p.normal_impulse,
+                    p.tangent_impulse[0],
+                    p.tangent_impulse[1],
+                    p.max_normal_impulse,
+                ]
+                .map(|x| x.to_bits())
+            };
+            assert_eq!(imp(p), imp(q), "manifold {}", c.manifold);
+        }
     }
 }
 
@@ -244,20 +277,19 @@ fn assert_lane(w: &WideConstraint, l: usize, c: Option<&ContactConstraint>, bodi
     let lane3 = |v: &V3| Vec3::new(lane(&v.x), lane(&v.y), lane(&v.z));
     let empty = ContactConstraint::EMPTY;
     let c_or = c.unwrap_or(&empty);
-    assert_eq!(w.manifold[l], c.map_or(NONE, |c| c.manifold));
-    assert_eq!(w.lens[l], c_or.len);
-    assert_eq!((w.a[l], w.b[l]), c.map_or((NONE, NONE), |c| (c.a, c.b)));
+    let index = |x: u32| if x == NO_SLOT { NONE } else { x as usize };
+    assert_eq!(index(w.manifold[l]), c.map_or(NONE, |c| c.manifold));
+    assert_eq!(w.lens[l] as usize, c_or.len);
+    let (wa, wb) = (index(w.a[l]), index(w.b[l]));
+    assert_eq!((wa, wb), c.map_or((NONE, NONE), |c| (c.a, c.b)));
     let dynamic = |s: usize| s != NONE && bodies[s].dynamic;
-    assert_eq!(
-        (w.write_a[l], w.write_b[l]),
-        (dynamic(w.a[l]), dynamic(w.b[l]))
-    );
+    assert_eq!((w.write_a[l], w.write_b[l]), (dynamic(wa), dynamic(wb)));
     let inv_m = |s: usize| if s == NONE { 0.0 } else { bodies[s].inv_m };
-    assert_eq!(lane(&w.inv_m_a).to_bits(), inv_m(w.a[l]).to_bits());
-    assert_eq!(lane(&w.inv_m_b).to_bits(), inv_m(w.b[l]).to_bits());
+    assert_eq!(lane(&w.inv_m_a).to_bits(), inv_m(wa).to_bits());
+    assert_eq!(lane(&w.inv_m_b).to_bits(), inv_m(wb).to_bits());
     assert_eq!(lane3(&w.normal), c_or.normal);
-    assert_eq!(lane3(&w.tangent[0]), c_or.tangent[0]);
-    assert_eq!(lane3(&w.tangent[1]), c_or.tangent[1]);
+    assert_eq!(lane3(&w.tangent), c_or.tangent[0]);
+    assert_eq!(lane3(&w.tangent1()), c_or.tangent[1]);
     assert_eq!(lane(&w.friction), c_or.friction);
     assert_eq!(lane(&w.restitution), c_or.restitution);
     assert_eq!(lane(&w.bias_rate), c_or.softness.bias_rate);
@@ -271,19 +303,25 @@ fn assert_lane(w: &WideConstraint, l: usize, c: Option<&ContactConstraint>, bodi
             PointConstraint::ZERO
         };
         let rows = [
-            (&wp.normal_row, &p.normal_row),
-            (&wp.tangent_rows[0], &p.tangent_rows[0]),
-            (&wp.tangent_rows[1], &p.tangent_rows[1]),
+            (&wp.normal_row, &p.normal_row, w.normal),
+            (&wp.tangent_rows[0], &p.tangent_rows[0], w.tangent),
+            (&wp.tangent_rows[1], &p.tangent_rows[1], w.tangent1()),
         ];
-        for (wr, r) in rows {
-            assert_eq!(lane3(&wr.ang_a), r.ang_a);
-            assert_eq!(lane3(&wr.ang_b), r.ang_b);
+        assert_eq!(lane3(&wp.arm_a), p.arm_a);
+        assert_eq!(lane3(&wp.arm_b), p.arm_b);
+        for (wr, r, d) in rows {
+            // The solve's recomputed Jacobian is the scalar row's, bit for bit (up to the
+            // sign of zero in a lane without the point, where the row's mass is zero).
+            let j = Angular::new(wp, d);
+            let bits = |v: Vec3| v.to_array().map(|x| if x == 0.0 { 0 } else { x.to_bits() });
+            assert_eq!(bits(lane3(&j.a)), bits(r.ang_a));
+            assert_eq!(bits(lane3(&j.b)), bits(r.ang_b));
             assert_eq!(lane3(&wr.inv_ang_a), r.inv_ang_a);
             assert_eq!(lane3(&wr.inv_ang_b), r.inv_ang_b);
             assert_eq!(lane(&wr.mass).to_bits(), r.mass.to_bits());
         }
         assert_eq!(lane(&wp.separation), p.separation);
-        assert_eq!(lane(&wp.relative_velocity), p.relative_velocity);
+        assert_eq!(lane(&w.relative_velocity[k]), p.relative_velocity);
         assert_eq!(lane(&wp.normal_impulse), p.normal_impulse);
         assert_eq!(lane(&wp.tangent_impulse[0]), p.tangent_impulse[0]);
         assert_eq!(lane(&wp.tangent_impulse[1]), p.tangent_impulse[1]);
@@ -488,4 +526,33 @@ fn frame_solve_matches_row_by_row_solve() {
         after[j] = b;
     }
     assert_eq!(before, after);
+}
+
+/// The layout the solve streams through: a point keeps its two lever arms, three rows of
+/// `I⁻¹ (r × d)` (both bodies) and effective mass, and five impulse and separation values —
+/// 32 lane values (512 bytes in f32, eight cache lines), down from 45 (720 bytes) while the
+/// rows also kept `r × d` and 33 while the point kept its relative velocity (now in the
+/// constraint, read by the restitution pass only).
+#[test]
+fn a_wide_point_is_32_lane_values() {
+    assert_eq!(
+        std::mem::size_of::<WidePoint>(),
+        32 * std::mem::size_of::<W>()
+    );
+    assert_eq!(std::mem::size_of::<WideRow>(), 7 * std::mem::size_of::<W>());
+}
+
+/// A wide constraint: 145 lane values (13 per constraint — the second tangent is
+/// recomputed —, 4 × 32 per point, the four points' relative velocities) and 80 bytes of
+/// `u32` lane indices, write flags and the point count — 2,400 bytes in f32 (2,512 with
+/// `usize` indices, a stored second tangent and the relative velocity in the points).
+#[test]
+fn a_wide_constraint_is_145_lane_values_and_80_bytes() {
+    let (w, align) = (std::mem::size_of::<W>(), std::mem::align_of::<W>());
+    let raw = 145 * w + 4 * 4 * 4 + 2 * 4 + std::mem::size_of::<usize>();
+    assert_eq!(raw, 145 * w + 80);
+    assert_eq!(
+        std::mem::size_of::<WideConstraint>(),
+        raw.div_ceil(align) * align
+    );
 }

@@ -20,6 +20,16 @@
 //! itself. Threads are forked with `rayon::join` (no allocation, unlike `rayon::scope` or
 //! `rayon::broadcast`).
 //!
+//! Which blocks a thread takes (Box2D's `b2GetWorkerStartIndex` and `b2ExecuteStage`):
+//! worker `w` of `n` starts at block `w·blocks/n` of every stage and claims blocks forward
+//! (each block has its own claim flag) until it meets a claimed one, then backward from
+//! its start until it meets a claimed one. So on two threads worker 0 takes the first half
+//! of every colour and body range and worker 1 the second, pass after pass, and the
+//! constraints and bodies a core wrote in one stage are mostly the ones it reads in the
+//! next (they stay in its own cache); a worker that finishes early steals from the far end
+//! of another's range. Every block is still claimed exactly once (a forward sweep only stops
+//! at a claimed block, and the backward sweeps close any gap behind a start).
+//!
 //! Determinism: the block boundaries are fixed when the list is built and never depend on
 //! the thread count, and blocks of one stage write disjoint data, so which thread runs a block
 //! cannot change a bit of the result.
@@ -38,8 +48,8 @@ pub(crate) struct Stage<K> {
     pub kind: K,
     /// Number of blocks (at least one).
     pub blocks: u32,
-    /// Blocks handed out so far (may run past `blocks`).
-    claimed: AtomicU32,
+    /// Index of the stage's first claim flag in [`StageList`]'s `claims`.
+    first: usize,
     /// Blocks finished.
     done: AtomicU32,
     /// When the stage was found finished, in nanoseconds since the region began.
@@ -48,16 +58,16 @@ pub(crate) struct Stage<K> {
 
 impl<K: Clone> Clone for Stage<K> {
     fn clone(&self) -> Self {
-        Stage::new(self.kind.clone(), self.blocks)
+        Stage::new(self.kind.clone(), self.blocks, self.first)
     }
 }
 
 impl<K> Stage<K> {
-    fn new(kind: K, blocks: u32) -> Self {
+    fn new(kind: K, blocks: u32, first: usize) -> Self {
         Stage {
             kind,
             blocks,
-            claimed: AtomicU32::new(0),
+            first,
             done: AtomicU32::new(0),
             end_ns: AtomicU64::new(0),
         }
@@ -76,6 +86,9 @@ pub(crate) struct StageList<K> {
     current: AtomicUsize,
     /// Set when a block panicked: every thread leaves the region so the panic can propagate.
     abort: AtomicBool,
+    /// One claim flag per block of every stage (Box2D's `b2SolverBlock::syncIndex`): set by
+    /// the thread that runs the block, cleared at the start of each run.
+    claims: Vec<AtomicBool>,
 }
 
 impl<K> Default for StageList<K> {
@@ -84,6 +97,7 @@ impl<K> Default for StageList<K> {
             stages: Vec::new(),
             current: AtomicUsize::new(0),
             abort: AtomicBool::new(false),
+            claims: Vec::new(),
         }
     }
 }
@@ -92,6 +106,7 @@ impl<K: Clone> Clone for StageList<K> {
     fn clone(&self) -> Self {
         StageList {
             stages: self.stages.clone(),
+            claims: self.claims.iter().map(|_| AtomicBool::new(false)).collect(),
             ..Default::default()
         }
     }
@@ -112,13 +127,17 @@ impl<K: Copy + Send + Sync> StageList<K> {
     /// Empties the list (keeps its buffer).
     pub fn clear(&mut self) {
         self.stages.clear();
+        self.claims.clear();
     }
 
     /// Appends a stage of `blocks` blocks; a stage without blocks is left out.
     pub fn push(&mut self, kind: K, blocks: usize) {
         if blocks > 0 {
             let blocks = u32::try_from(blocks).unwrap_or(u32::MAX);
-            self.stages.push(Stage::new(kind, blocks));
+            let first = self.claims.len();
+            self.claims
+                .extend((0..blocks).map(|_| AtomicBool::new(false)));
+            self.stages.push(Stage::new(kind, blocks, first));
         }
     }
 
@@ -138,8 +157,10 @@ impl<K: Copy + Send + Sync> StageList<K> {
     where
         F: Fn(K, usize, usize) + Sync,
     {
+        for c in &mut self.claims {
+            *c.get_mut() = false;
+        }
         for s in &mut self.stages {
-            *s.claimed.get_mut() = 0;
             *s.done.get_mut() = 0;
             *s.end_ns.get_mut() = 0;
         }
@@ -156,7 +177,9 @@ impl<K: Copy + Send + Sync> StageList<K> {
             return;
         }
         let this = &*self;
-        fan_out(threads, &|| this.work(&exec, base));
+        fan_out(threads, 0, &|worker| {
+            this.work(&exec, base, worker, threads)
+        });
     }
 
     /// The wall time of each stage of the last [`StageList::run`] (from the end of the
@@ -172,9 +195,25 @@ impl<K: Copy + Send + Sync> StageList<K> {
         })
     }
 
+    /// Claims block `b` of `stage` and runs it; false when another thread had claimed it.
+    #[inline]
+    fn try_run<F>(&self, stage: &Stage<K>, b: u32, exec: &F) -> bool
+    where
+        F: Fn(K, usize, usize) + Sync,
+    {
+        if self.claims[stage.first + b as usize].swap(true, Ordering::AcqRel) {
+            return false;
+        }
+        exec(stage.kind, b as usize, stage.blocks as usize);
+        // Release: whoever sees the last count sees every block's writes.
+        stage.done.fetch_add(1, Ordering::AcqRel);
+        true
+    }
+
     /// One thread's walk through the stages (Box2D's `b2SolverTask` and
-    /// `b2ExecuteMainStage` in one: every thread may advance the stage).
-    fn work<F>(&self, exec: &F, base: Instant)
+    /// `b2ExecuteMainStage` in one: every thread may advance the stage), as worker `worker`
+    /// of `workers` (which fixes its start block in every stage, see the module docs).
+    fn work<F>(&self, exec: &F, base: Instant, worker: usize, workers: usize)
     where
         F: Fn(K, usize, usize) + Sync,
     {
@@ -186,14 +225,19 @@ impl<K: Copy + Send + Sync> StageList<K> {
                 return;
             }
             let stage = &self.stages[s];
+            let blocks = stage.blocks;
+            let start = worker_start(worker, workers, blocks);
+            // Forward from the start while the blocks are free, then backward from it.
+            let mut b = start;
+            while self.try_run(stage, b, exec) {
+                b = if b + 1 == blocks { 0 } else { b + 1 };
+            }
+            let mut b = start;
             loop {
-                let b = stage.claimed.fetch_add(1, Ordering::Relaxed);
-                if b >= stage.blocks {
+                b = if b == 0 { blocks - 1 } else { b - 1 };
+                if !self.try_run(stage, b, exec) {
                     break;
                 }
-                exec(stage.kind, b as usize, stage.blocks as usize);
-                // Release: whoever sees the last count sees every block's writes.
-                stage.done.fetch_add(1, Ordering::AcqRel);
             }
             wait_until(|| {
                 stage.finished()
@@ -210,6 +254,15 @@ impl<K: Copy + Send + Sync> StageList<K> {
             }
         }
     }
+}
+
+/// The first block worker `worker` of `workers` tries in a stage of `blocks` blocks
+/// (Box2D's `b2GetWorkerStartIndex`): the workers' starts are spread evenly, so each one
+/// takes the same share of every stage.
+fn worker_start(worker: usize, workers: usize, blocks: u32) -> u32 {
+    let workers = workers.max(1) as u64;
+    let w = (worker as u64).min(workers - 1);
+    (w * u64::from(blocks) / workers) as u32
 }
 
 fn nanos_since(base: Instant) -> u64 {
@@ -230,21 +283,26 @@ fn wait_until(done: impl Fn() -> bool) {
     }
 }
 
-/// Runs `f` on up to `threads` threads of the current rayon pool (the caller is one of
-/// them), forking with `rayon::join` in a binary tree.
+/// Runs `f(worker)` on up to `threads` threads of the current rayon pool (the caller is
+/// one of them, worker `first`; the others are `first + 1 ..`), forking with `rayon::join`
+/// in a binary tree.
 #[cfg(feature = "parallel")]
-fn fan_out(threads: usize, f: &(dyn Fn() + Sync)) {
+fn fan_out(threads: usize, first: usize, f: &(dyn Fn(usize) + Sync)) {
     if threads <= 1 {
-        f();
+        f(first);
     } else {
-        let left = threads / 2;
-        rayon::join(|| fan_out(threads - left, f), || fan_out(left, f));
+        let right = threads / 2;
+        let left = threads - right;
+        rayon::join(
+            || fan_out(left, first, f),
+            || fan_out(right, first + left, f),
+        );
     }
 }
 
 #[cfg(not(feature = "parallel"))]
-fn fan_out(_: usize, f: &(dyn Fn() + Sync)) {
-    f();
+fn fan_out(_: usize, first: usize, f: &(dyn Fn(usize) + Sync)) {
+    f(first);
 }
 
 /// Threads the solver may use: the current rayon pool's when `parallel` (and the

@@ -156,3 +156,60 @@ fn a_panicking_block_reaches_the_caller_without_hanging() {
     }));
     assert!(r.is_err());
 }
+
+#[test]
+fn worker_starts_are_spread_over_the_blocks() {
+    for blocks in [1u32, 2, 3, 7, 16, 1000] {
+        for workers in [1usize, 2, 3, 8] {
+            let starts: Vec<u32> = (0..workers)
+                .map(|w| worker_start(w, workers, blocks))
+                .collect();
+            assert_eq!(starts[0], 0);
+            assert!(starts.windows(2).all(|p| p[0] <= p[1]));
+            assert!(starts.iter().all(|&s| s < blocks));
+            if blocks as usize >= workers {
+                // Distinct starts: each worker begins in its own share.
+                assert!(starts.windows(2).all(|p| p[0] < p[1]));
+            }
+        }
+    }
+    // A worker index past the count (never passed) still gives a valid block.
+    assert!(worker_start(9, 2, 5) < 5);
+}
+
+/// The forward and backward sweeps from the workers' start blocks claim every block of
+/// every stage exactly once, for stages with many more blocks than threads, with threads
+/// that may join late or be slowed down at random.
+#[test]
+fn start_block_sweeps_claim_every_block_once() {
+    let sizes: Vec<usize> = (0..40).map(|s| 1 + (s * 7) % 37).collect();
+    for threads in [2, 3, 5, 8] {
+        let mut list = StageList::<usize>::default();
+        for (s, &n) in sizes.iter().enumerate() {
+            list.push(s, n);
+        }
+        let runs: Vec<AtomicUsize> = (0..sizes.len() * 37).map(|_| AtomicUsize::new(0)).collect();
+        for round in 0..4 {
+            pool(threads).install(|| {
+                list.run(threads, |s, b, _| {
+                    // Uneven block costs, so that workers overtake and steal.
+                    let spin = (s * 31 + b * 17 + round) % 13;
+                    for _ in 0..spin * 200 {
+                        std::hint::spin_loop();
+                    }
+                    runs[s * 37 + b].fetch_add(1, Ordering::SeqCst);
+                })
+            });
+        }
+        for (s, &n) in sizes.iter().enumerate() {
+            for b in 0..37 {
+                let expect = if b < n { 4 } else { 0 };
+                assert_eq!(
+                    runs[s * 37 + b].load(Ordering::SeqCst),
+                    expect,
+                    "{threads} threads, stage {s}, block {b}"
+                );
+            }
+        }
+    }
+}
