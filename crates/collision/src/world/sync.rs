@@ -141,7 +141,7 @@ impl CollisionWorld {
             _ => return None,
         };
         let pose = check_pose_fast(s.pose).ok()?;
-        if !(s.margin.is_finite() && s.margin >= 0.0 && s.motion.is_finite()) {
+        if !(s.margin.is_finite() && s.margin >= 0.0) || !s.motion.is_finite() {
             return None;
         }
         let aabb = speculative_box(o.shape.aabb(&pose), s.margin, s.motion);
