@@ -143,8 +143,7 @@ pub struct CollisionWorld {
     changes: WorldPairChanges,
     narrowphase: NarrowPhase<ObjectHandle>,
     timings: UpdateTimings,
-    /// Reused buffer of [`CollisionWorld::sync_objects`] (its parallel passes).
-    #[cfg_attr(not(feature = "parallel"), allow(dead_code))]
+    /// Reused buffer of [`CollisionWorld::sync_objects`].
     sync_scratch: Vec<Option<sync::Synced>>,
 }
 

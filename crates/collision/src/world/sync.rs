@@ -46,13 +46,12 @@ impl CollisionWorld {
     /// [`CollisionWorld::sync_object`] for every entry of `items`, in order, with the same
     /// results and the same errors (the entries before the first failing one are applied).
     ///
-    /// With the `parallel` feature, more than one thread, at least two chunks of entries and
-    /// the handles in strictly ascending slot order (as a pipeline's loop over its bodies
-    /// gives), the boxes and the fat-box tests are computed first for all entries, in
-    /// parallel, in fixed chunks, and applied in a second, serial pass (the result does not
-    /// depend on the thread count); otherwise entry by entry. Unsorted handles go through
-    /// [`CollisionWorld::sync_object`] one by one (a repeated handle must see the previous
-    /// entry's pose).
+    /// When the handles are in strictly ascending slot order (as a pipeline's loop over its
+    /// bodies gives), the boxes and the fat-box tests are computed first for all entries
+    /// (in parallel with the `parallel` feature, in fixed chunks: the result does not depend
+    /// on the thread count) and applied in a second, serial pass; otherwise the entries go
+    /// through [`CollisionWorld::sync_object`] one by one (a repeated handle must see the
+    /// previous entry's pose).
     pub fn sync_objects(&mut self, items: &[ObjectSync]) -> Result<()> {
         let ascending = items
             .windows(2)
@@ -63,73 +62,60 @@ impl CollisionWorld {
             }
             return Ok(());
         }
-        #[cfg(feature = "parallel")]
-        if items.len() >= 2 * SYNC_CHUNK && rayon::current_num_threads() > 1 {
-            return self.sync_split(items);
-        }
-        // One thread: one pass, the same checks, box and broadphase update per entry.
-        for s in items {
-            self.sync_one(s)?;
-        }
-        Ok(())
-    }
-
-    /// The two passes of [`CollisionWorld::sync_objects`]: the first in parallel, in
-    /// chunks of [`SYNC_CHUNK`] entries, the second in order.
-    #[cfg(feature = "parallel")]
-    fn sync_split(&mut self, items: &[ObjectSync]) -> Result<()> {
-        use rayon::prelude::*;
         let mut out = std::mem::take(&mut self.sync_scratch);
         out.clear();
         out.resize(items.len(), None);
-        let this = &*self;
-        out.par_chunks_mut(SYNC_CHUNK)
-            .zip(items.par_chunks(SYNC_CHUNK))
-            .with_max_len(1)
-            .for_each(|(o, it)| {
-                for (o, s) in o.iter_mut().zip(it) {
-                    *o = this.prepare_sync(s);
-                }
-            });
+        self.prepare_syncs(items, &mut out);
         let mut result = Ok(());
         for (s, r) in items.iter().zip(&out) {
-            if let Err(e) = self.apply_sync(s, r) {
+            let Some(r) = r else {
+                // A check failed: the one-object path names the error.
+                if let Err(e) = self.sync_object(s.handle, s.pose, s.margin, s.motion) {
+                    result = Err(e);
+                    break;
+                }
+                continue;
+            };
+            if let Err(e) =
+                self.broadphase
+                    .apply_checked(s.handle.proxy(), &r.aabb, r.displacement, r.update)
+            {
                 result = Err(e);
                 break;
             }
+            let o = self.objects[s.handle.index as usize]
+                .as_mut()
+                .expect("checked by the first pass");
+            o.pose = r.pose;
+            o.margin = s.margin;
+            o.motion = s.motion;
+            o.aabb = r.aabb;
+            o.displacement = r.displacement;
+            // Already up to date: a pending `set_pose` must not be applied again by `update`.
+            o.dirty = false;
         }
         self.sync_scratch = out;
         result
     }
 
-    /// One entry of [`CollisionWorld::sync_objects`] in one pass.
-    #[inline]
-    fn sync_one(&mut self, s: &ObjectSync) -> Result<()> {
-        let r = self.prepare_sync(s);
-        self.apply_sync(s, &r)
-    }
-
-    /// The second pass of [`CollisionWorld::sync_objects`] for one entry and its first-pass
-    /// result `r`.
-    #[inline]
-    fn apply_sync(&mut self, s: &ObjectSync, r: &Option<Synced>) -> Result<()> {
-        let Some(r) = r else {
-            // A check failed: the one-object path names the error.
-            return self.sync_object(s.handle, s.pose, s.margin, s.motion);
-        };
-        self.broadphase
-            .apply_checked(s.handle.proxy(), &r.aabb, r.displacement, r.update)?;
-        let o = self.objects[s.handle.index as usize]
-            .as_mut()
-            .expect("checked by the first pass");
-        o.pose = r.pose;
-        o.margin = s.margin;
-        o.motion = s.motion;
-        o.aabb = r.aabb;
-        o.displacement = r.displacement;
-        // Already up to date: a pending `set_pose` must not be applied again by `update`.
-        o.dirty = false;
-        Ok(())
+    /// The first pass of [`CollisionWorld::sync_objects`] into `out` (as long as `items`).
+    fn prepare_syncs(&self, items: &[ObjectSync], out: &mut [Option<Synced>]) {
+        #[cfg(feature = "parallel")]
+        if items.len() >= 2 * SYNC_CHUNK {
+            use rayon::prelude::*;
+            out.par_chunks_mut(SYNC_CHUNK)
+                .zip(items.par_chunks(SYNC_CHUNK))
+                .with_max_len(1)
+                .for_each(|(o, it)| {
+                    for (o, s) in o.iter_mut().zip(it) {
+                        *o = self.prepare_sync(s);
+                    }
+                });
+            return;
+        }
+        for (o, s) in out.iter_mut().zip(items) {
+            *o = self.prepare_sync(s);
+        }
     }
 
     /// The checks and the box of [`CollisionWorld::sync_object`] for one entry, without

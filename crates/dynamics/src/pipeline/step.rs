@@ -137,12 +137,11 @@ impl World {
     }
 
     /// Copies the poses of moving bodies to their collision objects with speculative margins,
-    /// and the sleep state to the broadphase's resting hints. On more than one thread the
-    /// moving bodies' objects are gathered and synced in one batch
-    /// ([`CollisionWorld::sync_objects`]: boxes and fat-box tests first, in parallel, then
-    /// the writes), in body order; a resting hint that changes first syncs the batch
-    /// gathered so far, so the broadphase sees the same sequence of operations as a
-    /// per-body sync. On one thread each object is synced at once.
+    /// and the sleep state to the broadphase's resting hints. The moving bodies' objects are
+    /// gathered and synced in one batch ([`CollisionWorld::sync_objects`]: boxes and fat-box
+    /// tests first, in parallel, then the writes), in body order; a resting hint that
+    /// changes first syncs the batch gathered so far, so the broadphase sees the same
+    /// sequence of operations as a per-body sync.
     ///
     /// [`CollisionWorld::sync_objects`]: carom_collision::world::CollisionWorld::sync_objects
     #[inline(never)] // its own entry in profiles
@@ -166,12 +165,6 @@ impl World {
         speculative: bool,
         syncs: &mut Vec<ObjectSync>,
     ) -> Result<()> {
-        // One thread gains nothing from the batch's parallel pass: sync each object at once
-        // (the same results, tested in `carom-collision`'s `world_sync_batch`).
-        #[cfg(feature = "parallel")]
-        let batch = rayon::current_num_threads() > 1;
-        #[cfg(not(feature = "parallel"))]
-        let batch = false;
         for i in 0..self.object_of.len() {
             let Some(obj) = self.object_of[i] else {
                 continue;
@@ -206,18 +199,13 @@ impl World {
                 } else {
                     (0.0, Vec3::ZERO)
                 };
-                // Pose, margin, motion, box and broadphase proxy, in the batch or at once.
-                let margin = base + spin + motion.length();
-                if batch {
-                    syncs.push(ObjectSync {
-                        handle: obj,
-                        pose,
-                        margin,
-                        motion,
-                    });
-                } else {
-                    self.collision.sync_object(obj, pose, margin, motion)?;
-                }
+                // Pose, margin, motion, box and broadphase proxy, in the batch.
+                syncs.push(ObjectSync {
+                    handle: obj,
+                    pose,
+                    margin: base + spin + motion.length(),
+                    motion,
+                });
             } else {
                 let o = self.collision.get(obj)?;
                 let (teleported, has_motion) = (o.pose != pose, o.motion != Vec3::ZERO);
