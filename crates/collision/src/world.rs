@@ -14,9 +14,6 @@ use crate::shape::Shape;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
-mod sync;
-pub use sync::ObjectSync;
-
 /// A handle to an object of a [`CollisionWorld`]: its slot and the slot's generation
 /// (the broadphase proxy handle of the object).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
@@ -143,8 +140,6 @@ pub struct CollisionWorld {
     changes: WorldPairChanges,
     narrowphase: NarrowPhase<ObjectHandle>,
     timings: UpdateTimings,
-    /// Reused buffer of [`CollisionWorld::sync_objects`].
-    sync_scratch: Vec<Option<sync::Synced>>,
 }
 
 impl CollisionWorld {

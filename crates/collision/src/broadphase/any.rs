@@ -140,41 +140,6 @@ impl AnyBroadPhase {
         }
     }
 
-    /// Whether [`AnyBroadPhase::apply_checked`] must do more than record the box of live
-    /// proxy `proxy` for the checked `aabb` and `displacement`: for the two-tree method,
-    /// whether the leaf's fat box must be replaced (read only, so a batch can ask for many
-    /// proxies in parallel); always `true` for the other methods.
-    pub(crate) fn needs_update_checked(
-        &self,
-        proxy: ProxyHandle,
-        aabb: &Aabb,
-        displacement: Vec3,
-    ) -> bool {
-        match self {
-            AnyBroadPhase::Tree(b) => b.slot_needs_refit(proxy.index as usize, aabb, displacement),
-            _ => true,
-        }
-    }
-
-    /// [`AnyBroadPhase::update_proxy_checked`] given the answer of
-    /// [`AnyBroadPhase::needs_update_checked`] for the same arguments and the same state of
-    /// the proxy's leaf: when it was `false`, only the box is recorded.
-    pub(crate) fn apply_checked(
-        &mut self,
-        proxy: ProxyHandle,
-        aabb: &Aabb,
-        displacement: Vec3,
-        needs_update: bool,
-    ) -> Result<()> {
-        match self {
-            AnyBroadPhase::Tree(b) if !needs_update => {
-                b.set_slot_box(proxy.index as usize, aabb);
-                Ok(())
-            }
-            b => b.update_proxy_checked(proxy, aabb, displacement),
-        }
-    }
-
     fn inner(&self) -> &dyn BroadPhase {
         match self {
             AnyBroadPhase::Tree(b) => b,

@@ -191,23 +191,6 @@ impl TreeBroadPhase {
         }
     }
 
-    /// Whether [`TreeBroadPhase::update_slot`] would give live slot `i` a new fat box for
-    /// the checked `aabb` and `displacement` (read only).
-    #[inline]
-    pub(crate) fn slot_needs_refit(&self, i: usize, aabb: &Aabb, displacement: Vec3) -> bool {
-        let (t, leaf) = self.leaves[i];
-        self.trees[t].needs_new_fat(leaf.index as usize, aabb, displacement)
-    }
-
-    /// Records the checked box of live slot `i` whose fat box still holds it
-    /// ([`TreeBroadPhase::slot_needs_refit`] was `false`): [`TreeBroadPhase::update_slot`]
-    /// without the fat-box test.
-    #[inline]
-    pub(crate) fn set_slot_box(&mut self, i: usize, aabb: &Aabb) {
-        debug_assert!(self.fat[i].contains(aabb));
-        self.store.set_aabb_trusted(i, *aabb);
-    }
-
     /// Adds to `out` the candidate keys of moved proxy `m` against tree `t`. A pair of two
     /// moved proxies is reported only by the lower one (when both query, as Box2D v3's
     /// `b2PairQueryCallback`), so fewer duplicate keys reach the sort.

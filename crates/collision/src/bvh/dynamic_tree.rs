@@ -329,7 +329,7 @@ impl DynamicTree {
     /// `displacement`: the box left it, or the fat box is far larger than a fresh one (the
     /// object stopped; a stale sweep would keep producing useless candidate pairs).
     #[inline]
-    pub(crate) fn needs_new_fat(&self, i: usize, aabb: &Aabb, displacement: Vec3) -> bool {
+    fn needs_new_fat(&self, i: usize, aabb: &Aabb, displacement: Vec3) -> bool {
         let fat = self.nodes[i].aabb;
         if !fat.contains(aabb) {
             return true;

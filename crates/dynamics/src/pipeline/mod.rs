@@ -107,8 +107,6 @@ pub struct World {
     radius: Vec<Real>,
     /// Whether the body's object is hinted resting in the collision world.
     resting: Vec<bool>,
-    /// The moving objects' new states gathered by the sync (reused buffer).
-    syncs: Vec<carom_collision::world::ObjectSync>,
     /// Solver contacts of the current step (reused buffer).
     contacts: Vec<ContactManifold>,
     /// For each entry of `contacts`, the index of its narrowphase pair (see `contacts.rs`).
@@ -137,7 +135,6 @@ impl World {
             body_of: Vec::new(),
             radius: Vec::new(),
             resting: Vec::new(),
-            syncs: Vec::new(),
             contacts: Vec::new(),
             sources: Vec::new(),
             accumulator: 0.0,

@@ -5,7 +5,6 @@ use super::World;
 use crate::body::BodyType;
 use crate::world::StepReport;
 use carom_collision::math::{Real, Vec3};
-use carom_collision::world::ObjectSync;
 use carom_collision::{CaromError, Result};
 use std::time::{Duration, Instant};
 
@@ -137,34 +136,11 @@ impl World {
     }
 
     /// Copies the poses of moving bodies to their collision objects with speculative margins,
-    /// and the sleep state to the broadphase's resting hints. The moving bodies' objects are
-    /// gathered and synced in one batch ([`CollisionWorld::sync_objects`]: boxes and fat-box
-    /// tests first, in parallel, then the writes), in body order; a resting hint that
-    /// changes first syncs the batch gathered so far, so the broadphase sees the same
-    /// sequence of operations as a per-body sync.
-    ///
-    /// [`CollisionWorld::sync_objects`]: carom_collision::world::CollisionWorld::sync_objects
+    /// and the sleep state to the broadphase's resting hints.
     #[inline(never)] // its own entry in profiles
     pub(super) fn sync(&mut self, dt: Real) -> Result<()> {
         let base = 0.5 * self.params.manifold.prediction;
         let speculative = self.params.speculative;
-        let mut syncs = std::mem::take(&mut self.syncs);
-        syncs.clear();
-        let result = self.gather_syncs(dt, base, speculative, &mut syncs);
-        let result = result.and_then(|()| self.collision.sync_objects(&syncs));
-        self.syncs = syncs;
-        result
-    }
-
-    /// The loop of [`World::sync`]: pushes the moving bodies' objects to `syncs`, and
-    /// applies resting hints and the static and sleeping bodies' changes.
-    fn gather_syncs(
-        &mut self,
-        dt: Real,
-        base: Real,
-        speculative: bool,
-        syncs: &mut Vec<ObjectSync>,
-    ) -> Result<()> {
         for i in 0..self.object_of.len() {
             let Some(obj) = self.object_of[i] else {
                 continue;
@@ -181,9 +157,6 @@ impl World {
             // current fat box, and the box update below then refits it in its new tree.
             let resting = !moving;
             if resting != self.resting[i] {
-                // The objects gathered so far are synced before the migration.
-                self.collision.sync_objects(syncs)?;
-                syncs.clear();
                 self.collision.set_resting(obj, resting)?;
                 self.resting[i] = resting;
             }
@@ -199,13 +172,9 @@ impl World {
                 } else {
                     (0.0, Vec3::ZERO)
                 };
-                // Pose, margin, motion, box and broadphase proxy, in the batch.
-                syncs.push(ObjectSync {
-                    handle: obj,
-                    pose,
-                    margin: base + spin + motion.length(),
-                    motion,
-                });
+                // Pose, margin, motion, box and broadphase proxy in one call.
+                self.collision
+                    .sync_object(obj, pose, base + spin + motion.length(), motion)?;
             } else {
                 let o = self.collision.get(obj)?;
                 let (teleported, has_motion) = (o.pose != pose, o.motion != Vec3::ZERO);
