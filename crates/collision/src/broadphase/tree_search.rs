@@ -32,23 +32,7 @@ impl TreeBroadPhase {
                 this.query_moved(m, RESTING, &mut part.stack, &mut part.keys);
             }
         };
-        #[cfg(feature = "parallel")]
-        {
-            use rayon::prelude::*;
-            parts[..chunks]
-                .par_iter_mut()
-                .enumerate()
-                .with_max_len(1)
-                .for_each(|(c, part)| run(c, part));
-        }
-        #[cfg(not(feature = "parallel"))]
-        for (c, part) in parts[..chunks].iter_mut().enumerate() {
-            run(c, part);
-        }
-        for p in &parts[..chunks] {
-            out.extend_from_slice(&p.keys);
-        }
-        self.part_capacity = Part::capacities(&parts[..chunks], cap);
+        self.part_capacity = Part::run_all(&mut parts[..chunks], cap, run, out);
         self.parts = parts;
     }
 
@@ -96,23 +80,7 @@ impl TreeBroadPhase {
                 });
             }
         };
-        #[cfg(feature = "parallel")]
-        {
-            use rayon::prelude::*;
-            parts[..n]
-                .par_iter_mut()
-                .enumerate()
-                .with_max_len(1)
-                .for_each(|(t, part)| run(t, part));
-        }
-        #[cfg(not(feature = "parallel"))]
-        for (t, part) in parts[..n].iter_mut().enumerate() {
-            run(t, part);
-        }
-        for p in &parts[..n] {
-            out.extend_from_slice(&p.keys);
-        }
-        self.part_capacity = Part::capacities(&parts[..n], cap);
+        self.part_capacity = Part::run_all(&mut parts[..n], cap, run, out);
         self.tasks = tasks;
         self.task_scratch = scratch;
         self.parts = parts;
@@ -139,6 +107,32 @@ pub(super) struct Part {
 }
 
 impl Part {
+    /// Runs `run(i, part)` for every part (one rayon task each with the `parallel`
+    /// feature), appends the parts' keys to `out` in part order, and returns the buffer
+    /// capacities to ask of the next search (see [`Part::capacities`]).
+    fn run_all<F>(parts: &mut [Part], cap: [usize; 3], run: F, out: &mut Vec<u64>) -> [usize; 3]
+    where
+        F: Fn(usize, &mut Part) + Sync + Send,
+    {
+        #[cfg(feature = "parallel")]
+        {
+            use rayon::prelude::*;
+            parts
+                .par_iter_mut()
+                .enumerate()
+                .with_max_len(1)
+                .for_each(|(i, part)| run(i, part));
+        }
+        #[cfg(not(feature = "parallel"))]
+        for (i, part) in parts.iter_mut().enumerate() {
+            run(i, part);
+        }
+        for p in parts.iter() {
+            out.extend_from_slice(&p.keys);
+        }
+        Part::capacities(parts, cap)
+    }
+
     /// Clears the keys and grows every buffer to the capacities `cap` (keys, stack, pair
     /// stack) if it has less.
     fn prepare(&mut self, cap: [usize; 3]) {
