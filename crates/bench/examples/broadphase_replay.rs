@@ -15,7 +15,7 @@
 //! and position. `replay <file> <method> [margin] [motion_scale] [refit 0|1] [optimize] [full_sweep_fraction]` creates the
 //! proxies at the recorded initial boxes, then per step moves every non-static proxy
 //! (displacement = change of position, as `CollisionWorld::update` does) and updates the
-//! pairs; `margin`, `motion_scale` and `refit` tune the `tree` method. It prints the pair
+//! pairs; `margin` (default `TreeBroadPhase::DEFAULT_MARGIN`, the library's), `motion_scale` and `refit` tune the `tree` method. It prints the pair
 //! count of the last step and a checksum of all pair changes, equal for every method.
 
 use carom_collision::broadphase::{
@@ -147,7 +147,10 @@ fn replay(path: &str, method: &str, args: &[String]) -> Result<(), String> {
         .map_err(|e: carom_collision::CaromError| e.to_string())?;
     let mut bp = AnyBroadPhase::new(method);
     if let AnyBroadPhase::Tree(t) = &mut bp {
-        let margin: Real = args.first().and_then(|a| a.parse().ok()).unwrap_or(0.1);
+        let margin: Real = args
+            .first()
+            .and_then(|a| a.parse().ok())
+            .unwrap_or(TreeBroadPhase::DEFAULT_MARGIN);
         let strategy = if method == Method::TreeManhattan {
             InsertStrategy::Manhattan
         } else {
