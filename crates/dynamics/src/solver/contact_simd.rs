@@ -30,8 +30,8 @@ mod build;
 #[cfg(test)]
 pub(crate) use build::store;
 #[cfg(test)]
-pub(crate) use build::{build, write_back};
-pub(crate) use build::{fill, store_range};
+pub(crate) use build::{build, fill, write_back};
+pub(crate) use build::{assign, build_range, store_range};
 
 /// Maps a scalar type to its four-lane vector.
 pub(crate) trait Lanes {

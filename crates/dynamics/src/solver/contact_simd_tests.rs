@@ -357,7 +357,6 @@ fn fill_writes_every_lane_and_overwrites_stale_ones() {
                 made.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
                 *c = cons[k].clone();
             },
-            false,
         );
         let made = made.load(std::sync::atomic::Ordering::Relaxed);
         assert_eq!(made, count, "each constraint is prepared once");
@@ -426,7 +425,6 @@ fn store_matches_the_scalar_store() {
         &bodies,
         points,
         |k, c, _| *c = cons[k].clone(),
-        false,
     );
     let (mut m_wide, mut m_scalar) = (manifolds.clone(), manifolds);
     store(&wide, &mut m_wide, 4.0);

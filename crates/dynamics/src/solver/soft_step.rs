@@ -54,7 +54,6 @@ pub(crate) fn step(ctx: &mut StepContext) {
         soft,
         static_soft,
         simd,
-        threads > 1,
         scratch,
     );
     let rows = &mut *ctx.joint_scratch;
@@ -83,6 +82,7 @@ pub(crate) fn step(ctx: &mut StepContext) {
         bodies: terms.len(),
         min_batch: p.parallel_min_batch,
         wide: if simd { scratch.wide.cons.len() } else { 0 },
+        prepare: simd,
     };
     soft_stages::plan(plan, &shape);
     let consts = soft_stages::Consts {
@@ -93,6 +93,9 @@ pub(crate) fn step(ctx: &mut StepContext) {
         restitution_threshold: p.restitution_threshold,
         simd,
         impulse_scale: n as Real,
+        impulse_in: warm,
+        contact_soft: (soft, static_soft),
+        min_batch: p.parallel_min_batch,
     };
     lap(&mut t, &mut ctx.timings.prepare);
 
@@ -113,6 +116,7 @@ pub(crate) fn step(ctx: &mut StepContext) {
             SoftStage::IntegrateVelocities => &mut ctx.timings.forces,
             SoftStage::IntegratePositions => &mut ctx.timings.integrate,
             SoftStage::StoreBodies | SoftStage::StoreImpulses => &mut ctx.timings.store,
+            SoftStage::Prepare(_) | SoftStage::PrepareRest => &mut ctx.timings.prepare,
             SoftStage::Joints(pass, _, _)
             | SoftStage::Colour(pass, _)
             | SoftStage::Serial(pass, _, _) => match pass {
