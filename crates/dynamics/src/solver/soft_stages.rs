@@ -6,7 +6,8 @@
 //! constraints it then solves (they are in its cache), and the colours of one block and
 //! the overflow colour in one stage of one block each (Box2D v3 prepares its contacts in a
 //! parallel stage too, `b2PrepareContactsTask`). Then,
-//! per substep: integrate velocities (blocks of bodies); warm start every joint colour
+//! per substep: integrate velocities (blocks of bodies; the first also computes the bodies'
+//! per-step terms); warm start every joint colour
 //! (blocks of joints; the joint overflow colour one block), then every contact colour
 //! (blocks of constraints), then the contact overflow colour (one block); solve likewise;
 //! integrate positions (blocks of bodies); refresh and relax every joint colour (each joint
@@ -80,8 +81,12 @@ pub(crate) enum Pass {
 /// One stage of the soft step.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) enum SoftStage {
-    /// Gravity, forces, damping and the gyroscopic term, in blocks of bodies.
-    IntegrateVelocities,
+    /// Gravity, forces, damping and the gyroscopic term, in blocks of bodies. The flag
+    /// marks the step's first one, whose blocks first compute their bodies' per-step terms
+    /// (`integrate::fill_terms`; only the selection of the moving bodies,
+    /// `integrate::select_terms`, runs before the list), in the blocks every later body
+    /// stage uses.
+    IntegrateVelocities(bool),
     /// Joint colour `k` (an index into the joint colour ranges, the last one the joint
     /// overflow colour, which is one block), in blocks of joints. The flag marks the step's
     /// first joint pass, which first computes the effective masses of the joints' rows
@@ -211,7 +216,7 @@ pub(crate) fn plan(list: &mut StageList<SoftStage>, s: &Shape) {
     }
     let body_blocks = block_count(s.bodies, BODY_BLOCK);
     for i in 0..s.substeps {
-        list.push(SoftStage::IntegrateVelocities, body_blocks);
+        list.push(SoftStage::IntegrateVelocities(i == 0), body_blocks);
         if s.warm_starting {
             s.pass(list, Pass::WarmStart, i == 0);
         }
@@ -242,6 +247,10 @@ pub(crate) struct Consts {
     pub contact_soft: (Softness, Softness),
     /// [`Shape::min_batch`], for the prepare stages to find the colours of one block.
     pub min_batch: usize,
+    /// Gravity, for the bodies' per-step terms.
+    pub gravity: Vec3,
+    /// Whether the velocity update takes the implicit gyroscopic term.
+    pub gyroscopic: bool,
 }
 
 /// Raw views of everything the blocks write, shared by the threads of the region.
@@ -366,11 +375,15 @@ impl Shared<'_> {
     unsafe fn exec(&self, kind: SoftStage, block: usize, blocks: usize) {
         let c = &self.c;
         match kind {
-            SoftStage::IntegrateVelocities => {
+            SoftStage::IntegrateVelocities(first) => {
                 for i in block_range(self.n_terms, blocks, block) {
                     let t = &mut *self.terms.add(i);
                     let s = t.slot();
                     assert!(s < self.n_bodies && s < self.n_poses);
+                    if first {
+                        let (set, b) = (&*self.set, &*self.bodies.add(s));
+                        integrate::fill_terms(t, set, b, c.gravity, c.h, c.gyroscopic);
+                    }
                     let q = *self.rotation.add(s);
                     integrate::integrate_velocity(t, q, &mut *self.bodies.add(s), c.h);
                 }

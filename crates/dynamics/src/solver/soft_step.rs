@@ -43,7 +43,8 @@ pub(crate) fn step(ctx: &mut StepContext) {
     let (soft, static_soft) = contact::softness_pair(&p, h);
     let scratch = &mut ctx.scratch.contacts;
     let terms = &mut ctx.scratch.terms;
-    integrate::prepare_terms(ctx.set, ctx.bodies, ctx.gravity, h, ctx.gyroscopic, terms);
+    // Only the selection is serial: the first velocity stage fills the terms in its blocks.
+    integrate::select_terms(ctx.set, ctx.bodies, terms);
     let simd = p.simd;
     let threads = thread_count(ctx.parallel);
     contact::prepare(
@@ -96,6 +97,8 @@ pub(crate) fn step(ctx: &mut StepContext) {
         impulse_in: warm,
         contact_soft: (soft, static_soft),
         min_batch: p.parallel_min_batch,
+        gravity: ctx.gravity,
+        gyroscopic: ctx.gyroscopic,
     };
     lap(&mut t, &mut ctx.timings.prepare);
 
@@ -113,7 +116,7 @@ pub(crate) fn step(ctx: &mut StepContext) {
     );
     for (kind, d) in plan.durations() {
         let slot = match kind {
-            SoftStage::IntegrateVelocities => &mut ctx.timings.forces,
+            SoftStage::IntegrateVelocities(_) => &mut ctx.timings.forces,
             SoftStage::IntegratePositions => &mut ctx.timings.integrate,
             SoftStage::StoreBodies | SoftStage::StoreImpulses => &mut ctx.timings.store,
             SoftStage::Prepare(_) | SoftStage::PrepareRest => &mut ctx.timings.prepare,
