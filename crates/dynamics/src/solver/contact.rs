@@ -224,7 +224,16 @@ impl Preparer<'_> {
         let m_index = self.selected[self.order[k]];
         let m = &self.manifolds[m_index];
         let (set, bodies) = (self.set, self.bodies);
-        prepare_one(out, m, m_index, set, bodies, self.impulse_in, self.soft, rows);
+        prepare_one(
+            out,
+            m,
+            m_index,
+            set,
+            bodies,
+            self.impulse_in,
+            self.soft,
+            rows,
+        );
     }
 }
 

@@ -29,9 +29,9 @@ use std::ops::Range;
 mod build;
 #[cfg(test)]
 pub(crate) use build::store;
+pub(crate) use build::{assign, build_range, store_range};
 #[cfg(test)]
 pub(crate) use build::{build, fill, write_back};
-pub(crate) use build::{assign, build_range, store_range};
 
 /// Maps a scalar type to its four-lane vector.
 pub(crate) trait Lanes {

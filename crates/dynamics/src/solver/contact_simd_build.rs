@@ -296,7 +296,8 @@ pub(crate) fn assign(
             (*n, at) = (at, at + *n);
         }
         let start = out.members.len();
-        out.members.resize(start + r.len().div_ceil(LANES), [NONE; LANES]);
+        out.members
+            .resize(start + r.len().div_ceil(LANES), [NONE; LANES]);
         let members = &mut out.members[start..];
         for k in r.clone() {
             let pos = &mut next[slot(k)];

@@ -209,7 +209,10 @@ pub(crate) fn plan(list: &mut StageList<SoftStage>, s: &Shape) {
             match s.colour_blocks(r) {
                 0 => {}
                 1 => rest += 1,
-                blocks => list.push(SoftStage::Prepare(u8::try_from(k).unwrap_or(u8::MAX)), blocks),
+                blocks => list.push(
+                    SoftStage::Prepare(u8::try_from(k).unwrap_or(u8::MAX)),
+                    blocks,
+                ),
             }
         }
         list.push(SoftStage::PrepareRest, rest);
