@@ -374,7 +374,10 @@ impl Shared<'_> {
     /// terms and poses) of their own range of terms, and every body appears in one term;
     /// contact and joint colour blocks touch their own constraints (joints: rows and blocks)
     /// and their dynamic bodies, disjoint within a colour, and only read non-dynamic bodies
-    /// and the poses; serial stages are a single block.
+    /// and the poses; serial stages are a single block. Prepare blocks write their own wide
+    /// constraints (or the overflow colour's scalar constraints, one block) and only read
+    /// the manifolds, the body set and the solver bodies, which no block of those stages
+    /// writes; the first velocity stage's blocks write the terms of their own range.
     unsafe fn exec(&self, kind: SoftStage, block: usize, blocks: usize) {
         let c = &self.c;
         match kind {

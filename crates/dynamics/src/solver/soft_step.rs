@@ -9,10 +9,12 @@
 //! (`dp`, `dq`) accumulated since the start of the step. Impulses are per substep inside and
 //! stored per step outside.
 //!
-//! Everything from the first substep to the restitution pass is one list of stages (module
-//! `stages`, Box2D's `b2SolverStage`s) run in one parallel region: the body stages in blocks
-//! of bodies, each joint and contact colour in blocks of constraints, the overflow colours
-//! as single blocks, and the store of the velocities, world inertias and wide constraints'
+//! Everything from the build of the wide contact constraints (SIMD; the selection, the
+//! colouring and the lane assignment run before) to the restitution pass is one list of
+//! stages (module `stages`, Box2D's `b2SolverStage`s) run in one parallel region: the
+//! contact build in the blocks of each colour's passes, the body stages in blocks of
+//! bodies, each joint and contact colour in blocks of constraints, the overflow colours as
+//! single blocks, and the store of the velocities, world inertias and wide constraints'
 //! impulses (module `soft_stages`).
 
 use super::soft_stages::{self, Pass, SoftStage};
