@@ -76,7 +76,8 @@ const DAMP_V: u8 = 8;
 const DAMP_W: u8 = 16;
 
 /// Fills `out` with the [`BodyTerms`] of every moving body for substeps of `h` (after
-/// [`load`]). Allocates only when `out` must grow.
+/// [`load`]): [`select_terms`], then [`fill_terms`] for each. Allocates only when `out`
+/// must grow.
 pub(crate) fn prepare_terms(
     set: &BodySet,
     bodies: &[SolverBody],
@@ -85,46 +86,97 @@ pub(crate) fn prepare_terms(
     gyroscopic: bool,
     out: &mut Vec<BodyTerms>,
 ) {
-    out.clear();
+    select_terms(set, bodies, out);
+    for t in out.iter_mut() {
+        fill_terms(t, set, &bodies[t.slot], gravity, h, gyroscopic);
+    }
+}
+
+/// Resizes `out` to one entry per moving body (awake dynamic or live kinematic), in slot
+/// order, and sets only each entry's slot; [`fill_terms`] writes the rest (the soft step
+/// does that in the parallel blocks of its first velocity stage, so only this cheap pass
+/// over the slots stays serial). Allocates only when `out` must grow.
+pub(crate) fn select_terms(set: &BodySet, bodies: &[SolverBody], out: &mut Vec<BodyTerms>) {
+    let mut n = 0;
     for (i, b) in bodies.iter().enumerate() {
-        let kinematic = set.is_alive(i) && set.info[i].body_type == BodyType::Kinematic;
-        if !(b.dynamic || kinematic) {
+        let kinematic = || set.is_alive(i) && set.info[i].body_type == BodyType::Kinematic;
+        if !(b.dynamic || kinematic()) {
             continue;
         }
-        let info = &set.info[i];
-        let mut t = BodyTerms {
-            slot: i,
+        if let Some(t) = out.get_mut(n) {
+            t.slot = i;
+        } else {
+            out.push(BodyTerms::at(i));
+        }
+        n += 1;
+    }
+    out.truncate(n);
+}
+
+impl BodyTerms {
+    /// Terms of slot `slot` with nothing else set yet ([`fill_terms`] sets them).
+    fn at(slot: usize) -> BodyTerms {
+        BodyTerms {
+            slot,
             dv: Vec3::ZERO,
             dw: Vec3::ZERO,
             damp_v: 1.0,
             damp_w: 1.0,
-            max_v: info.max_linear_speed,
-            max_w: info.max_angular_speed,
-            max_v_sq: info.max_linear_speed * info.max_linear_speed,
-            max_w_sq: info.max_angular_speed * info.max_angular_speed,
+            max_v: 0.0,
+            max_w: 0.0,
+            max_v_sq: 0.0,
+            max_w_sq: 0.0,
             inertia: Mat3::ZERO,
             flags: 0,
-        };
-        if b.dynamic {
-            t.flags |= DYNAMIC;
-            t.dv = (gravity * info.gravity_scale + set.force[i] * b.inv_m) * h;
-            t.dw = b.inv_i * (set.torque[i] * h);
-            if gyroscopic && !is_isotropic(&info.inv_inertia_local) {
-                t.flags |= GYROSCOPIC;
-                // Until `INERTIA` is set: the local inverse inertia.
-                t.inertia = info.inv_inertia_local;
-            }
-            if info.linear_damping > 0.0 {
-                t.flags |= DAMP_V;
-                t.damp_v = (1.0 - info.linear_damping).clamp(0.0, 1.0).powf(h);
-            }
-            if info.angular_damping > 0.0 {
-                t.flags |= DAMP_W;
-                t.damp_w = (1.0 - info.angular_damping).clamp(0.0, 1.0).powf(h);
-            }
         }
-        out.push(t);
     }
+}
+
+/// Writes every field of `out` but its slot (set by [`select_terms`]) for substeps of `h`:
+/// `b` is the solver body of that slot.
+#[inline]
+pub(crate) fn fill_terms(
+    out: &mut BodyTerms,
+    set: &BodySet,
+    b: &SolverBody,
+    gravity: Vec3,
+    h: Real,
+    gyroscopic: bool,
+) {
+    let i = out.slot;
+    let info = &set.info[i];
+    let mut t = BodyTerms {
+        slot: i,
+        dv: Vec3::ZERO,
+        dw: Vec3::ZERO,
+        damp_v: 1.0,
+        damp_w: 1.0,
+        max_v: info.max_linear_speed,
+        max_w: info.max_angular_speed,
+        max_v_sq: info.max_linear_speed * info.max_linear_speed,
+        max_w_sq: info.max_angular_speed * info.max_angular_speed,
+        inertia: Mat3::ZERO,
+        flags: 0,
+    };
+    if b.dynamic {
+        t.flags |= DYNAMIC;
+        t.dv = (gravity * info.gravity_scale + set.force[i] * b.inv_m) * h;
+        t.dw = b.inv_i * (set.torque[i] * h);
+        if gyroscopic && !is_isotropic(&info.inv_inertia_local) {
+            t.flags |= GYROSCOPIC;
+            // Until `INERTIA` is set: the local inverse inertia.
+            t.inertia = info.inv_inertia_local;
+        }
+        if info.linear_damping > 0.0 {
+            t.flags |= DAMP_V;
+            t.damp_v = (1.0 - info.linear_damping).clamp(0.0, 1.0).powf(h);
+        }
+        if info.angular_damping > 0.0 {
+            t.flags |= DAMP_W;
+            t.damp_w = (1.0 - info.angular_damping).clamp(0.0, 1.0).powf(h);
+        }
+    }
+    *out = t;
 }
 
 /// Whether a local inverse inertia is a multiple of the identity (cubes, spheres, regular

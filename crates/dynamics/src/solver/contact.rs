@@ -181,18 +181,73 @@ pub(crate) struct ContactScratch {
     selected: Vec<usize>,
     /// Body slots of each selected manifold.
     pairs: Vec<(usize, usize)>,
+    /// Point count of each selected manifold (read by the lane assignment, which would
+    /// otherwise look each manifold up again).
+    lens: Vec<u8>,
     colour: ColourScratch,
 }
 
-/// Builds the constraints of the manifolds that touch an awake dynamic body, in colour
-/// order (module `coloring`), with the colour ranges in `scratch.colouring.ranges`.
-/// Scalar (`simd` false): all of them into `scratch.cons`. SIMD: the colours but the
-/// overflow one straight into the lanes of `scratch.wide` (`contact_simd::fill`), the
-/// overflow colour into `scratch.cons`. `impulse_in` scales the stored impulses (per-step
-/// units) to the solver's units (0 disables warm start). The manifolds are coloured first
-/// and each constraint is built once, at its place: no reordering copy of the (large)
-/// constraints. Allocates only when a buffer of `scratch` must grow. With `parallel` (and
-/// SIMD) the wide constraints are built on rayon (`contact_simd::fill`), with the same bits.
+impl ContactScratch {
+    /// The manifold index of each selected manifold (indexed by the colouring's `order`).
+    pub(crate) fn selected(&self) -> &[usize] {
+        &self.selected
+    }
+}
+
+/// What preparing one constraint reads: the step's manifolds and bodies, the selection and
+/// its colour order, the warm-start factor and the softness pair. [`Preparer::make`] is the
+/// one routine behind the serial build in [`prepare`] and the soft step's prepare stages
+/// (module `soft_stages`), so both give the same bits.
+#[derive(Clone, Copy)]
+pub(crate) struct Preparer<'a> {
+    /// The step's manifolds.
+    pub manifolds: &'a [ContactManifold],
+    /// Manifold index of each selected manifold ([`ContactScratch::selected`]).
+    pub selected: &'a [usize],
+    /// The colour order (`Colouring::order`): position `k` holds a selection index.
+    pub order: &'a [usize],
+    /// The body set (poses and centres of mass).
+    pub set: &'a BodySet,
+    /// The solver bodies.
+    pub bodies: &'a [SolverBody],
+    /// Factor of the stored impulses (per-step units to the solver's; 0: no warm start).
+    pub impulse_in: Real,
+    /// Softness between two dynamic bodies and against a non-dynamic one.
+    pub soft: (Softness, Softness),
+}
+
+impl Preparer<'_> {
+    /// Prepares the constraint at position `k` of the colour order into `out` (its Jacobian
+    /// rows only when `rows`), as [`prepare_one`] does.
+    #[inline]
+    pub(crate) fn make(&self, k: usize, out: &mut ContactConstraint, rows: bool) {
+        let m_index = self.selected[self.order[k]];
+        let m = &self.manifolds[m_index];
+        let (set, bodies) = (self.set, self.bodies);
+        prepare_one(
+            out,
+            m,
+            m_index,
+            set,
+            bodies,
+            self.impulse_in,
+            self.soft,
+            rows,
+        );
+    }
+}
+
+/// Selects the manifolds that touch an awake dynamic body and colours them (module
+/// `coloring`), with the colour ranges in `scratch.colouring.ranges`, and builds their
+/// constraints in colour order. Scalar (`simd` false): all of them into `scratch.cons`.
+/// SIMD: the colours but the overflow one go four at a time into the lanes of
+/// `scratch.wide` (`contact_simd::assign`) and the overflow colour into `scratch.cons`; the
+/// constraints themselves are *not* built here but by the soft step's prepare stages, in
+/// parallel blocks (`soft_stages`, with a [`Preparer`]), and `scratch.cons` is only sized
+/// to the overflow colour. `impulse_in` scales the stored impulses (per-step units) to the
+/// solver's units (0 disables warm start). The manifolds are coloured first and each
+/// constraint is built once, at its place: no reordering copy of the (large) constraints.
+/// Allocates only when a buffer of `scratch` must grow.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn prepare(
     manifolds: &[ContactManifold],
@@ -202,7 +257,6 @@ pub(crate) fn prepare(
     soft: Softness,
     static_soft: Softness,
     simd: bool,
-    parallel: bool,
     scratch: &mut ContactScratch,
 ) {
     let ContactScratch {
@@ -211,10 +265,12 @@ pub(crate) fn prepare(
         wide,
         selected,
         pairs,
+        lens,
         colour,
     } = scratch;
     selected.clear();
     pairs.clear();
+    lens.clear();
     for (m_index, m) in manifolds.iter().enumerate() {
         let (a, b) = (m.body_a.index as usize, m.body_b.index as usize);
         if m.points().is_empty() || !(bodies[a].dynamic || bodies[b].dynamic) {
@@ -222,6 +278,7 @@ pub(crate) fn prepare(
         }
         selected.push(m_index);
         pairs.push((a, b));
+        lens.push(m.points().len().min(MAX_MANIFOLD_POINTS) as u8);
     }
     colour_into(
         pairs,
@@ -231,29 +288,30 @@ pub(crate) fn prepare(
         colouring,
     );
     let order = &colouring.order;
-    let make = |k: usize, out: &mut ContactConstraint, rows: bool| {
-        let m_index = selected[order[k]];
-        let m = &manifolds[m_index];
-        prepare_one(
-            out,
-            m,
-            m_index,
+    if simd {
+        let points = |k: usize| usize::from(lens[order[k]]);
+        let ranges = &colouring.ranges;
+        super::contact_simd::assign(wide, ranges, points);
+        // The overflow colour's constraints are prepared in place by the prepare stages;
+        // stale entries are overwritten there (every field the solve reads).
+        let n = ranges.last().map_or(0, |r| r.len());
+        cons.truncate(n);
+        cons.resize(n, ContactConstraint::EMPTY);
+        wide.overflow = 0..n;
+    } else {
+        let p = Preparer {
+            manifolds,
+            selected,
+            order,
             set,
             bodies,
             impulse_in,
-            (soft, static_soft),
-            rows,
-        )
-    };
-    if simd {
-        let points = |k: usize| manifolds[selected[order[k]]].points().len();
-        let ranges = &colouring.ranges;
-        super::contact_simd::fill(wide, cons, ranges, bodies, points, make, parallel);
-    } else {
+            soft: (soft, static_soft),
+        };
         cons.clear();
         cons.extend((0..order.len()).map(|k| {
             let mut c = ContactConstraint::EMPTY;
-            make(k, &mut c, true);
+            p.make(k, &mut c, true);
             c
         }));
     }

@@ -29,9 +29,9 @@ use std::ops::Range;
 mod build;
 #[cfg(test)]
 pub(crate) use build::store;
+pub(crate) use build::{assign, build_range, store_range};
 #[cfg(test)]
-pub(crate) use build::{build, write_back};
-pub(crate) use build::{fill, store_range};
+pub(crate) use build::{build, fill, write_back};
 
 /// Maps a scalar type to its four-lane vector.
 pub(crate) trait Lanes {

@@ -228,58 +228,81 @@ impl WideConstraint {
     }
 }
 
-/// Builds the constraints of a step: `make(k, out, rows)` prepares the constraint at
-/// position `k` of the colour order (its Jacobian rows only when `rows`: the lanes' rows
-/// are built four at a time from the lever arms by [`WideConstraint::finish`]), which will have `points(k)` points; `ranges` are the colour ranges of
-/// that order, the last being the overflow colour. The constraints of each colour but the
-/// last go four at a time into the lanes of `out.cons` (reusing last step's wide
-/// constraints); the overflow colour's go to `cons` (cleared first), and `out.overflow` is
-/// their range there. Allocates only when a buffer must grow.
-///
-/// Inside a colour the constraints are grouped by point count (four-point ones first, in
-/// colour order within a count): a wide constraint solves as many points as its fullest
-/// lane, so mixing a one-point lane with a four-point lane wastes three points of work. The
-/// constraints of a colour share no dynamic body, so their order inside the colour does not
-/// change any result (and depends only on the colour order, not on the thread count).
-///
-/// The lanes are assigned first (serially, cheap), then the wide constraints are built, on
-/// rayon in chunks of [`BUILD_CHUNK`] when `parallel` and the pool has more than one thread:
-/// each wide constraint is written only from its own lanes, so the result is the same bits
-/// whatever the thread count. The constraint preparation was half of what stayed serial in a
-/// two-thread "1000 stack" step.
-#[allow(clippy::too_many_arguments)]
+/// Builds the constraints of a step at once: [`assign`] the lanes, [`build_range`] every
+/// wide constraint, then prepare the overflow colour's scalar constraints into `cons`
+/// (cleared first; `out.overflow` is their range there). `make(k, out, rows)` prepares the
+/// constraint at position `k` of the colour order (its Jacobian rows only when `rows`),
+/// which will have `points(k)` points; `ranges` are the colour ranges of that order, the
+/// last being the overflow colour. The soft step does not call this: it assigns the lanes
+/// before its stage list and builds them in the list's first stages (module
+/// `soft_stages`), each block on the thread that later solves it. Allocates only when a
+/// buffer must grow.
+#[cfg(test)]
 pub(crate) fn fill(
     out: &mut WideScratch,
     cons: &mut Vec<ContactConstraint>,
     ranges: &[Range<usize>],
     bodies: &[SolverBody],
     points: impl Fn(usize) -> usize,
-    make: impl Fn(usize, &mut ContactConstraint, bool) + Sync,
-    parallel: bool,
+    make: impl Fn(usize, &mut ContactConstraint, bool),
 ) {
+    assign(out, ranges, points);
+    build_range(&mut out.cons, &out.members, bodies, &make);
     cons.clear();
+    if let Some(overflow) = ranges.last() {
+        cons.extend(overflow.clone().map(|k| {
+            let mut c = ContactConstraint::EMPTY;
+            make(k, &mut c, true);
+            c
+        }));
+    }
+    out.overflow = 0..cons.len();
+}
+
+/// Assigns the constraints of every colour but the last (`ranges`, colour ranges of the
+/// colour order; the last is the overflow colour, kept scalar) to the lanes of wide
+/// constraints, four at a time: `out.members[w][l]` is the colour-order index of lane `l`
+/// of wide constraint `w` (`NONE` for padding) and `out.ranges` the wide range of each
+/// colour. `out.cons` is resized to the wide constraints needed (reusing last step's; their
+/// lanes are overwritten by [`build_range`]). `points(k)` is the point count of constraint
+/// `k`. Allocates only when a buffer must grow.
+///
+/// Inside a colour the constraints are grouped by point count (four-point ones first, in
+/// colour order within a count): a wide constraint solves as many points as its fullest
+/// lane, so mixing a one-point lane with a four-point lane wastes three points of work. The
+/// constraints of a colour share no dynamic body, so their order inside the colour does not
+/// change any result (and depends only on the colour order, not on the thread count).
+pub(crate) fn assign(
+    out: &mut WideScratch,
+    ranges: &[Range<usize>],
+    points: impl Fn(usize) -> usize,
+) {
     out.ranges.clear();
     out.members.clear();
-    let Some((overflow, colours)) = ranges.split_last() else {
-        out.cons.clear();
-        out.overflow = 0..0;
-        return;
-    };
-    let bucket = |k: usize| points(k).clamp(1, MAX_MANIFOLD_POINTS);
+    let colours = ranges.split_last().map_or(&[][..], |(_, c)| c);
+    // Slot of a constraint with `count` points among the colour's: the four-point ones
+    // first, so `MAX_MANIFOLD_POINTS - count` (a point count clamped to 1..=4).
+    let slot = |k: usize| MAX_MANIFOLD_POINTS - points(k).clamp(1, MAX_MANIFOLD_POINTS);
     for r in colours {
+        // A counting sort by point count, stable in colour order: count, then place each
+        // constraint at its slot's next position (lane `pos % LANES` of wide constraint
+        // `pos / LANES`); the last wide constraint's unused lanes stay padding.
+        let mut next = [0usize; MAX_MANIFOLD_POINTS];
+        for k in r.clone() {
+            next[slot(k)] += 1;
+        }
+        let mut at = 0;
+        for n in &mut next {
+            (*n, at) = (at, at + *n);
+        }
         let start = out.members.len();
-        // Lane of the next constraint in the last wide constraint.
-        let mut lane = LANES;
-        for count in (1..=MAX_MANIFOLD_POINTS).rev() {
-            for k in r.clone().filter(|&k| bucket(k) == count) {
-                if lane == LANES {
-                    out.members.push([NONE; LANES]);
-                    lane = 0;
-                }
-                let last = out.members.len() - 1;
-                out.members[last][lane] = k;
-                lane += 1;
-            }
+        out.members
+            .resize(start + r.len().div_ceil(LANES), [NONE; LANES]);
+        let members = &mut out.members[start..];
+        for k in r.clone() {
+            let pos = &mut next[slot(k)];
+            members[*pos / LANES][*pos % LANES] = k;
+            *pos += 1;
         }
         out.ranges.push(start..out.members.len());
     }
@@ -288,61 +311,34 @@ pub(crate) fn fill(
         out.cons.resize_with(used, WideConstraint::empty);
     }
     out.cons.truncate(used);
-    // One chunk of wide constraints; one constraint at a time is prepared and written into
-    // its lane.
-    let build = |ws: &mut [WideConstraint], ms: &[[usize; LANES]]| {
-        let mut c = ContactConstraint::EMPTY;
-        let mut inputs = RowInputs::default();
-        for (w, m) in ws.iter_mut().zip(ms) {
-            w.len = 0;
-            for (lane, &k) in m.iter().enumerate() {
-                if k == NONE {
-                    w.set_lane(lane, None, bodies, &mut inputs);
-                } else {
-                    make(k, &mut c, false);
-                    w.len = w.len.max(c.len);
-                    w.set_lane(lane, Some(&c), bodies, &mut inputs);
-                }
+}
+
+/// Builds the wide constraints `ws` whose lanes hold the constraints `ms` (their
+/// [`WideScratch::members`]): one constraint at a time is prepared (`make(k, c, false)`,
+/// without its rows) and written into its lane, then [`WideConstraint::finish`] builds the
+/// rows of the four lanes at once. Each wide constraint is written only from its own lanes,
+/// so disjoint ranges can be built on different threads with the same bits.
+pub(crate) fn build_range(
+    ws: &mut [WideConstraint],
+    ms: &[[usize; LANES]],
+    bodies: &[SolverBody],
+    make: &impl Fn(usize, &mut ContactConstraint, bool),
+) {
+    let mut c = ContactConstraint::EMPTY;
+    let mut inputs = RowInputs::default();
+    for (w, m) in ws.iter_mut().zip(ms) {
+        w.len = 0;
+        for (lane, &k) in m.iter().enumerate() {
+            if k == NONE {
+                w.set_lane(lane, None, bodies, &mut inputs);
+            } else {
+                make(k, &mut c, false);
+                w.len = w.len.max(c.len);
+                w.set_lane(lane, Some(&c), bodies, &mut inputs);
             }
-            w.finish(&inputs);
         }
-    };
-    let (ws, ms) = (&mut out.cons[..], &out.members[..]);
-    if !(parallel && build_parallel(ws, ms, &build)) {
-        build(ws, ms);
+        w.finish(&inputs);
     }
-    cons.extend(overflow.clone().map(|k| {
-        let mut c = ContactConstraint::EMPTY;
-        make(k, &mut c, true);
-        c
-    }));
-    out.overflow = 0..cons.len();
-}
-
-/// Wide constraints per rayon task of [`fill`].
-#[cfg_attr(not(feature = "parallel"), allow(dead_code))]
-pub(crate) const BUILD_CHUNK: usize = 32;
-
-/// Runs `build` over chunks of `ws` and `ms` on rayon; false (nothing done) when there is
-/// one thread or too little work.
-#[cfg(feature = "parallel")]
-fn build_parallel<F>(ws: &mut [WideConstraint], ms: &[[usize; LANES]], build: &F) -> bool
-where
-    F: Fn(&mut [WideConstraint], &[[usize; LANES]]) + Sync,
-{
-    use rayon::prelude::*;
-    if rayon::current_num_threads() < 2 || ws.len() < 2 * BUILD_CHUNK {
-        return false;
-    }
-    ws.par_chunks_mut(BUILD_CHUNK)
-        .zip(ms.par_chunks(BUILD_CHUNK))
-        .for_each(|(w, m)| build(w, m));
-    true
-}
-
-#[cfg(not(feature = "parallel"))]
-fn build_parallel<F>(_: &mut [WideConstraint], _: &[[usize; LANES]], _: &F) -> bool {
-    false
 }
 
 /// Groups already prepared scalar constraints (`cons`, in colour order with colour `ranges`,
@@ -360,14 +356,14 @@ pub(crate) fn build(
     let points = |k: usize| cons[k].len;
     let Some((overflow, colours)) = ranges.split_last() else {
         let make = |k: usize, c: &mut ContactConstraint, _: bool| *c = cons[k].clone();
-        fill(out, &mut scratch, ranges, bodies, points, make, false);
+        fill(out, &mut scratch, ranges, bodies, points, make);
         return;
     };
     // The overflow colour is left out of the lanes and kept in `cons` by range.
     let mut rs: Vec<Range<usize>> = colours.to_vec();
     rs.push(overflow.start..overflow.start);
     let make = |k: usize, c: &mut ContactConstraint, _: bool| *c = cons[k].clone();
-    fill(out, &mut scratch, &rs, bodies, points, make, false);
+    fill(out, &mut scratch, &rs, bodies, points, make);
     out.overflow = overflow.clone();
 }
 

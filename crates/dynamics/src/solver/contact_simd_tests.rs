@@ -357,7 +357,6 @@ fn fill_writes_every_lane_and_overwrites_stale_ones() {
                 made.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
                 *c = cons[k].clone();
             },
-            false,
         );
         let made = made.load(std::sync::atomic::Ordering::Relaxed);
         assert_eq!(made, count, "each constraint is prepared once");
@@ -426,7 +425,6 @@ fn store_matches_the_scalar_store() {
         &bodies,
         points,
         |k, c, _| *c = cons[k].clone(),
-        false,
     );
     let (mut m_wide, mut m_scalar) = (manifolds.clone(), manifolds);
     store(&wide, &mut m_wide, 4.0);
@@ -555,4 +553,51 @@ fn a_wide_constraint_is_145_lane_values_and_80_bytes() {
         std::mem::size_of::<WideConstraint>(),
         raw.div_ceil(align) * align
     );
+}
+
+/// `assign` (a counting sort by point count) puts every constraint in the lane the direct
+/// rule gives: per colour, the four-point constraints first, then three, two and one, each
+/// in colour order, four lanes per wide constraint, padding only in a colour's last one.
+/// The oracle is that rule written as four filtered passes (the previous implementation);
+/// point counts 0 (treated as 1) to 4, empty colours, colours of 1–40 constraints.
+#[test]
+fn lane_assignment_matches_the_four_pass_rule() {
+    let mut rng = Rng(0xa551);
+    let mut wide = WideScratch::default();
+    for round in 0..200 {
+        let colours = 1 + round % 7;
+        let mut ranges = Vec::new();
+        let mut start = 0;
+        for _ in 0..=colours {
+            let len = (rng.next() * 41.0) as usize % 41 * usize::from(rng.next() > 0.1);
+            ranges.push(start..start + len);
+            start += len;
+        }
+        let counts: Vec<usize> = (0..start)
+            .map(|_| (rng.next() * 5.0) as usize % 5)
+            .collect();
+        assign(&mut wide, &ranges, |k| counts[k]);
+        // The oracle.
+        let mut members: Vec<[usize; LANES]> = Vec::new();
+        let mut wide_ranges = Vec::new();
+        for r in &ranges[..ranges.len() - 1] {
+            let first = members.len();
+            let mut lane = LANES;
+            for count in (1..=MAX_MANIFOLD_POINTS).rev() {
+                for k in r.clone().filter(|&k| counts[k].clamp(1, 4) == count) {
+                    if lane == LANES {
+                        members.push([NONE; LANES]);
+                        lane = 0;
+                    }
+                    let last = members.len() - 1;
+                    members[last][lane] = k;
+                    lane += 1;
+                }
+            }
+            wide_ranges.push(first..members.len());
+        }
+        assert_eq!(wide.members, members, "round {round}");
+        assert_eq!(wide.ranges, wide_ranges, "round {round}");
+        assert_eq!(wide.cons.len(), members.len());
+    }
 }

@@ -33,7 +33,6 @@ pub(crate) fn step(ctx: &mut StepContext) {
         Softness::RIGID,
         Softness::RIGID,
         false,
-        false,
         scratch,
     );
     let (cons, ranges) = (&mut scratch.cons, &scratch.colouring.ranges[..]);

@@ -1,7 +1,13 @@
 //! The soft step's stage list and the executor of its blocks (Box2D v3's `b2SolverStage_*`
 //! values and `b2ExecuteBlock`), run by module `stages`.
 //!
-//! Per substep: integrate velocities (blocks of bodies); warm start every joint colour
+//! First the contact constraints are built (SIMD only): each colour's wide constraints in
+//! the same blocks as that colour's pass stages, so on two threads each core builds the
+//! constraints it then solves (they are in its cache), and the colours of one block and
+//! the overflow colour in one stage of one block each (Box2D v3 prepares its contacts in a
+//! parallel stage too, `b2PrepareContactsTask`). Then,
+//! per substep: integrate velocities (blocks of bodies; the first also computes the bodies'
+//! per-step terms); warm start every joint colour
 //! (blocks of joints; the joint overflow colour one block), then every contact colour
 //! (blocks of constraints), then the contact overflow colour (one block); solve likewise;
 //! integrate positions (blocks of bodies); refresh and relax every joint colour (each joint
@@ -45,6 +51,20 @@ pub(crate) const JOINT_BLOCK: usize = 32;
 /// refreshed and solved, several times a contact's work).
 const JOINT_WEIGHT: usize = 8;
 
+/// Blocks of a contact colour of `len` items (wide constraints with SIMD, `lanes` scalar
+/// constraints each): none for an empty colour, one below `min_batch` scalar constraints,
+/// else blocks of [`WIDE_BLOCK`] (SIMD) or [`SCALAR_BLOCK`] items. Depends only on the
+/// counts, never on the thread count.
+fn colour_blocks(len: usize, lanes: usize, min_batch: usize) -> usize {
+    if len == 0 {
+        0
+    } else if len * lanes < min_batch {
+        1
+    } else {
+        block_count(len, if lanes > 1 { WIDE_BLOCK } else { SCALAR_BLOCK })
+    }
+}
+
 /// A contact or joint pass.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) enum Pass {
@@ -61,8 +81,12 @@ pub(crate) enum Pass {
 /// One stage of the soft step.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) enum SoftStage {
-    /// Gravity, forces, damping and the gyroscopic term, in blocks of bodies.
-    IntegrateVelocities,
+    /// Gravity, forces, damping and the gyroscopic term, in blocks of bodies. The flag
+    /// marks the step's first one, whose blocks first compute their bodies' per-step terms
+    /// (`integrate::fill_terms`; only the selection of the moving bodies,
+    /// `integrate::select_terms`, runs before the list), in the blocks every later body
+    /// stage uses.
+    IntegrateVelocities(bool),
     /// Joint colour `k` (an index into the joint colour ranges, the last one the joint
     /// overflow colour, which is one block), in blocks of joints. The flag marks the step's
     /// first joint pass, which first computes the effective masses of the joints' rows
@@ -85,6 +109,15 @@ pub(crate) enum SoftStage {
     /// After the last pass: the wide constraints' impulses back into their manifolds
     /// (`contact_simd::store`), in blocks of [`STORE_BLOCK`] wide constraints.
     StoreImpulses,
+    /// Before the first substep (SIMD): builds the wide constraints of colour `k` (an index
+    /// into the colour ranges) in the blocks of that colour's pass stages
+    /// ([`Shape::colour_blocks`]), so block `b` is built by the worker that starts at block
+    /// `b` of the passes.
+    Prepare(u8),
+    /// Before the first substep (SIMD): one block per contact colour of one block, in
+    /// colour order, then (if any) one block for the scalar constraints of the overflow
+    /// colour.
+    PrepareRest,
 }
 
 /// What the stage list of a step depends on.
@@ -106,18 +139,15 @@ pub(crate) struct Shape<'a> {
     pub min_batch: usize,
     /// Wide constraints whose impulses the store stage writes back (0 without SIMD).
     pub wide: usize,
+    /// Whether the list starts with the stages that build the contact constraints (SIMD:
+    /// `contact::prepare` only assigned the lanes).
+    pub prepare: bool,
 }
 
 impl Shape<'_> {
     /// Blocks of colour `r`.
     fn colour_blocks(&self, r: &Range<usize>) -> usize {
-        if r.is_empty() {
-            0
-        } else if r.len() * self.lanes < self.min_batch {
-            1
-        } else {
-            block_count(r.len(), self.item_block())
-        }
+        colour_blocks(r.len(), self.lanes, self.min_batch)
     }
 
     /// Blocks of joint colour `k`.
@@ -128,14 +158,6 @@ impl Shape<'_> {
             1
         } else {
             block_count(r.len(), JOINT_BLOCK)
-        }
-    }
-
-    fn item_block(&self) -> usize {
-        if self.lanes > 1 {
-            WIDE_BLOCK
-        } else {
-            SCALAR_BLOCK
         }
     }
 
@@ -181,9 +203,23 @@ impl Shape<'_> {
 /// Fills `list` with the stages of one soft step.
 pub(crate) fn plan(list: &mut StageList<SoftStage>, s: &Shape) {
     list.clear();
+    if s.prepare {
+        let mut rest = usize::from(s.overflow > 0);
+        for (k, r) in s.colours.iter().enumerate() {
+            match s.colour_blocks(r) {
+                0 => {}
+                1 => rest += 1,
+                blocks => list.push(
+                    SoftStage::Prepare(u8::try_from(k).unwrap_or(u8::MAX)),
+                    blocks,
+                ),
+            }
+        }
+        list.push(SoftStage::PrepareRest, rest);
+    }
     let body_blocks = block_count(s.bodies, BODY_BLOCK);
     for i in 0..s.substeps {
-        list.push(SoftStage::IntegrateVelocities, body_blocks);
+        list.push(SoftStage::IntegrateVelocities(i == 0), body_blocks);
         if s.warm_starting {
             s.pass(list, Pass::WarmStart, i == 0);
         }
@@ -207,6 +243,17 @@ pub(crate) struct Consts {
     pub simd: bool,
     /// Factor of the stored impulses (per substep to per step: the substep count).
     pub impulse_scale: Real,
+    /// Factor of the manifolds' stored impulses for the prepare stages (per step to per
+    /// substep; 0 without warm starting).
+    pub impulse_in: Real,
+    /// Contact softness between two dynamic bodies and against a non-dynamic one.
+    pub contact_soft: (Softness, Softness),
+    /// [`Shape::min_batch`], for the prepare stages to find the colours of one block.
+    pub min_batch: usize,
+    /// Gravity, for the bodies' per-step terms.
+    pub gravity: Vec3,
+    /// Whether the velocity update takes the implicit gyroscopic term.
+    pub gyroscopic: bool,
 }
 
 /// Raw views of everything the blocks write, shared by the threads of the region.
@@ -233,6 +280,14 @@ struct Shared<'a> {
     cons: *mut ContactConstraint,
     n_cons: usize,
     overflow: Range<usize>,
+    /// Colour-order position of the overflow colour's first constraint.
+    overflow_order: usize,
+    /// The lanes of each wide constraint (colour-order positions).
+    members: &'a [[usize; contact_simd::LANES]],
+    /// Manifold index of each selected manifold.
+    selected: &'a [usize],
+    /// The colour order (selection index at each position).
+    order: &'a [usize],
     rows: JointView,
     joint_colours: &'a [Range<usize>],
     joints: &'a JointSet,
@@ -272,6 +327,7 @@ pub(crate) fn run(
         let (last, colours) = r.split_last().map_or((0..0, r), |(l, c)| (l.clone(), c));
         (colours, last)
     };
+    let overflow_order = scratch.colouring.ranges.last().map_or(0, |r| r.start);
     let shared = Shared {
         c,
         n_bodies: bodies.len(),
@@ -295,6 +351,10 @@ pub(crate) fn run(
         n_cons: scratch.cons.len(),
         cons: scratch.cons.as_mut_ptr(),
         overflow,
+        overflow_order,
+        members: &scratch.wide.members,
+        selected: scratch.selected(),
+        order: &scratch.colouring.order,
         rows: JointView::new(rows),
         joint_colours: &rows.colours,
         joints,
@@ -314,15 +374,22 @@ impl Shared<'_> {
     /// terms and poses) of their own range of terms, and every body appears in one term;
     /// contact and joint colour blocks touch their own constraints (joints: rows and blocks)
     /// and their dynamic bodies, disjoint within a colour, and only read non-dynamic bodies
-    /// and the poses; serial stages are a single block.
+    /// and the poses; serial stages are a single block. Prepare blocks write their own wide
+    /// constraints (or the overflow colour's scalar constraints, one block) and only read
+    /// the manifolds, the body set and the solver bodies, which no block of those stages
+    /// writes; the first velocity stage's blocks write the terms of their own range.
     unsafe fn exec(&self, kind: SoftStage, block: usize, blocks: usize) {
         let c = &self.c;
         match kind {
-            SoftStage::IntegrateVelocities => {
+            SoftStage::IntegrateVelocities(first) => {
                 for i in block_range(self.n_terms, blocks, block) {
                     let t = &mut *self.terms.add(i);
                     let s = t.slot();
                     assert!(s < self.n_bodies && s < self.n_poses);
+                    if first {
+                        let (set, b) = (&*self.set, &*self.bodies.add(s));
+                        integrate::fill_terms(t, set, b, c.gravity, c.h, c.gyroscopic);
+                    }
                     let q = *self.rotation.add(s);
                     integrate::integrate_velocity(t, q, &mut *self.bodies.add(s), c.h);
                 }
@@ -349,6 +416,22 @@ impl Shared<'_> {
                         *self.inv_inertia_world.add(s) =
                             world_inertia(*self.rotation.add(s), inv_local);
                     }
+                }
+            }
+            SoftStage::Prepare(k) => {
+                let r = &self.colours[k as usize];
+                let b = block_range(r.len(), blocks, block);
+                self.prepare_wide(r.start + b.start..r.start + b.end);
+            }
+            SoftStage::PrepareRest => {
+                let small = self
+                    .colours
+                    .iter()
+                    .filter(|r| colour_blocks(r.len(), contact_simd::LANES, c.min_batch) == 1)
+                    .nth(block);
+                match small {
+                    Some(r) => self.prepare_wide(r.clone()),
+                    None => self.prepare_overflow(),
                 }
             }
             SoftStage::StoreImpulses => {
@@ -400,6 +483,40 @@ impl Shared<'_> {
                     }
                 }
             }
+        }
+    }
+
+    /// What the prepare stages read. Nothing writes the manifolds, the body set or the
+    /// solver bodies while they run.
+    unsafe fn preparer(&self) -> contact::Preparer<'_> {
+        let c = &self.c;
+        contact::Preparer {
+            manifolds: std::slice::from_raw_parts(self.manifolds, self.n_manifolds),
+            selected: self.selected,
+            order: self.order,
+            set: &*self.set,
+            bodies: std::slice::from_raw_parts(self.bodies, self.n_bodies),
+            impulse_in: c.impulse_in,
+            soft: c.contact_soft,
+        }
+    }
+
+    /// Builds the wide constraints `range` (a prepare block).
+    unsafe fn prepare_wide(&self, range: Range<usize>) {
+        assert!(range.end <= self.n_wide && range.end <= self.members.len());
+        let p = self.preparer();
+        let ws = std::slice::from_raw_parts_mut(self.wide.add(range.start), range.len());
+        let make = |k: usize, out: &mut ContactConstraint, rows: bool| p.make(k, out, rows);
+        contact_simd::build_range(ws, &self.members[range], p.bodies, &make);
+    }
+
+    /// Builds the scalar constraints of the overflow colour (one block).
+    unsafe fn prepare_overflow(&self) {
+        let range = self.overflow.clone();
+        assert!(range.end <= self.n_cons);
+        let p = self.preparer();
+        for i in range {
+            p.make(self.overflow_order + i, &mut *self.cons.add(i), true);
         }
     }
 

@@ -9,10 +9,12 @@
 //! (`dp`, `dq`) accumulated since the start of the step. Impulses are per substep inside and
 //! stored per step outside.
 //!
-//! Everything from the first substep to the restitution pass is one list of stages (module
-//! `stages`, Box2D's `b2SolverStage`s) run in one parallel region: the body stages in blocks
-//! of bodies, each joint and contact colour in blocks of constraints, the overflow colours
-//! as single blocks, and the store of the velocities, world inertias and wide constraints'
+//! Everything from the build of the wide contact constraints (SIMD; the selection, the
+//! colouring and the lane assignment run before) to the restitution pass is one list of
+//! stages (module `stages`, Box2D's `b2SolverStage`s) run in one parallel region: the
+//! contact build in the blocks of each colour's passes, the body stages in blocks of
+//! bodies, each joint and contact colour in blocks of constraints, the overflow colours as
+//! single blocks, and the store of the velocities, world inertias and wide constraints'
 //! impulses (module `soft_stages`).
 
 use super::soft_stages::{self, Pass, SoftStage};
@@ -43,7 +45,8 @@ pub(crate) fn step(ctx: &mut StepContext) {
     let (soft, static_soft) = contact::softness_pair(&p, h);
     let scratch = &mut ctx.scratch.contacts;
     let terms = &mut ctx.scratch.terms;
-    integrate::prepare_terms(ctx.set, ctx.bodies, ctx.gravity, h, ctx.gyroscopic, terms);
+    // Only the selection is serial: the first velocity stage fills the terms in its blocks.
+    integrate::select_terms(ctx.set, ctx.bodies, terms);
     let simd = p.simd;
     let threads = thread_count(ctx.parallel);
     contact::prepare(
@@ -54,7 +57,6 @@ pub(crate) fn step(ctx: &mut StepContext) {
         soft,
         static_soft,
         simd,
-        threads > 1,
         scratch,
     );
     let rows = &mut *ctx.joint_scratch;
@@ -83,6 +85,7 @@ pub(crate) fn step(ctx: &mut StepContext) {
         bodies: terms.len(),
         min_batch: p.parallel_min_batch,
         wide: if simd { scratch.wide.cons.len() } else { 0 },
+        prepare: simd,
     };
     soft_stages::plan(plan, &shape);
     let consts = soft_stages::Consts {
@@ -93,6 +96,11 @@ pub(crate) fn step(ctx: &mut StepContext) {
         restitution_threshold: p.restitution_threshold,
         simd,
         impulse_scale: n as Real,
+        impulse_in: warm,
+        contact_soft: (soft, static_soft),
+        min_batch: p.parallel_min_batch,
+        gravity: ctx.gravity,
+        gyroscopic: ctx.gyroscopic,
     };
     lap(&mut t, &mut ctx.timings.prepare);
 
@@ -110,9 +118,10 @@ pub(crate) fn step(ctx: &mut StepContext) {
     );
     for (kind, d) in plan.durations() {
         let slot = match kind {
-            SoftStage::IntegrateVelocities => &mut ctx.timings.forces,
+            SoftStage::IntegrateVelocities(_) => &mut ctx.timings.forces,
             SoftStage::IntegratePositions => &mut ctx.timings.integrate,
             SoftStage::StoreBodies | SoftStage::StoreImpulses => &mut ctx.timings.store,
+            SoftStage::Prepare(_) | SoftStage::PrepareRest => &mut ctx.timings.prepare,
             SoftStage::Joints(pass, _, _)
             | SoftStage::Colour(pass, _)
             | SoftStage::Serial(pass, _, _) => match pass {
