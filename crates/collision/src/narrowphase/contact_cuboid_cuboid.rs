@@ -477,8 +477,9 @@ mod tests {
     }
 
     /// The clip gives the reference clip's points and ids bit for bit: faces fully inside
-    /// the reference face (the skipped passes), overhanging on one or more sides, crossing,
-    /// touching a side plane exactly, rotated 45°, thin and zero-thickness boxes, 1 km out.
+    /// the reference face (the skipped passes), missing it, overhanging on one or more
+    /// sides, crossing, touching a side plane exactly, rotated 45°, thin and zero-thickness
+    /// boxes, 1 km out.
     #[test]
     fn clip_matches_the_reference_bit_for_bit() {
         let mut seed = 0x9e37_79b9_7f4a_7c15_u64;
@@ -488,7 +489,7 @@ mod tests {
             seed ^= seed << 17;
             (seed >> 11) as Real / (1u64 << 53) as Real
         };
-        let mut skipped_all = 0;
+        let (mut skipped_all, mut missed) = (0, 0);
         for case in 0..20000 {
             let far = if case % 3 == 0 { 1000.0 } else { 0.0 };
             let h = |r: &mut dyn FnMut() -> Real| {
@@ -543,10 +544,13 @@ mod tests {
                 if prediction > 1.0 && got.len() == 4 && got.iter().all(|c| c.1 & 0xFF == 0xFF) {
                     skipped_all += 1;
                 }
+                missed += (prediction > 1.0 && got.is_empty()) as usize;
             }
         }
         // Incident faces fully inside the reference face occur (the skipped passes run).
         assert!(skipped_all > 100, "{skipped_all}");
+        // Faces that miss (a pass with every corner outside ends the clip) occur too.
+        assert!(missed > 100, "{missed}");
     }
     /// `Mat3::from_quat` of the inverse (conjugate) quaternion is the transpose of the
     /// quaternion's matrix bit for bit (what `clip_face_b` relies on): random, axis-aligned,
@@ -616,7 +620,11 @@ mod tests {
             // B's centre so that A lies (roughly) over B's face `fb`.
             let mut nb = Vec3::ZERO;
             nb[fb / 2] = if fb % 2 == 0 { 1.0 } else { -1.0 };
-            let gap = if case % 5 == 0 { 0.0 } else { (rnd() - 0.7) * 0.2 };
+            let gap = if case % 5 == 0 {
+                0.0
+            } else {
+                (rnd() - 0.7) * 0.2
+            };
             let off = Vec3::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5) * 0.5;
             // A in B's frame, then B in A's frame.
             let a_in_b = Isometry::new(nb * (hb[fb / 2] + ha.max_element() + gap) + off, rot);

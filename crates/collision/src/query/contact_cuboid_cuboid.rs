@@ -648,8 +648,13 @@ mod tests {
             let rot_m = pose.rotation_matrix();
             for prediction in [0.0 as Real, 0.02, 5.0] {
                 let want = axis_reference(&a, &b, &pose, prediction);
-                let got =
-                    cuboid_cuboid_axis_or_separation_mat(&a, &b, &rot_m, pose.translation, prediction);
+                let got = cuboid_cuboid_axis_or_separation_mat(
+                    &a,
+                    &b,
+                    &rot_m,
+                    pose.translation,
+                    prediction,
+                );
                 match (got, want) {
                     (Ok((go, gn, gk)), Ok((wo, wn, wk))) => {
                         assert_eq!((go.to_bits(), bits(gn), gk), (wo.to_bits(), bits(wn), wk));
@@ -667,9 +672,15 @@ mod tests {
             }
         }
         // The paths the test means to cover do occur.
-        assert!(overlaps > 1000 && aparts > 1000 && edges > 100, "{overlaps} {aparts} {edges}");
+        assert!(
+            overlaps > 1000 && aparts > 1000 && edges > 100,
+            "{overlaps} {aparts} {edges}"
+        );
         // Non-finite input is rejected the same way.
-        let (a, b) = (Cuboid::new(Vec3::ONE).unwrap(), Cuboid::new(Vec3::ONE).unwrap());
+        let (a, b) = (
+            Cuboid::new(Vec3::ONE).unwrap(),
+            Cuboid::new(Vec3::ONE).unwrap(),
+        );
         let pose = Isometry::new(Vec3::new(Real::NAN, 0.0, 0.0), Quat::IDENTITY);
         let got = cuboid_cuboid_axis_or_separation_mat(
             &a,
