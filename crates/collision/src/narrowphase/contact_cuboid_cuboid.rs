@@ -619,7 +619,7 @@ mod tests {
             };
             // B's centre so that A lies (roughly) over B's face `fb`.
             let mut nb = Vec3::ZERO;
-            nb[fb / 2] = if fb % 2 == 0 { 1.0 } else { -1.0 };
+            nb[fb / 2] = if fb.is_multiple_of(2) { 1.0 } else { -1.0 };
             let gap = if case % 5 == 0 {
                 0.0
             } else {
