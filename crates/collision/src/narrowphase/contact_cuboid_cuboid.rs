@@ -211,6 +211,7 @@ impl Poly {
 /// `id_base | face << 16 | corner << 8 | 0xFF` for incident corners, the corner's id with
 /// the side plane's index in the low byte for points made by the clip. Nothing is appended
 /// when the incident face misses the reference face's prism (the caller then falls back).
+/// `rot_ri` is `pose_ri.rotation_matrix()`, built once by the caller.
 #[allow(clippy::too_many_arguments)]
 fn clip_box_faces(
     hr: Vec3,
@@ -230,9 +231,8 @@ fn clip_box_faces(
 
 /// [`clip_box_faces`] with the incident box's pose given as its rotation matrix `rot` and
 /// centre `t` in the reference frame, handing each kept point to `emit` (in the reference
-/// frame). The
-/// polygon lives in two fixed buffers used in turn (it was a pair of 16-point `SmallVec`s
-/// swapped after each clip, and a `Vec3` indexed by a runtime axis: the copies and the
+/// frame). The polygon lives in two fixed buffers used in turn (it was a pair of 16-point
+/// `SmallVec`s swapped after each clip, and a `Vec3` indexed by a runtime axis: the copies and the
 /// index `match`es were half of the clip's instructions in "3000 fall"). The arithmetic is
 /// the same, operation for operation, so the points are the same bits.
 #[inline(always)]
