@@ -160,16 +160,20 @@ impl ContactManifold {
         } else {
             p0.rotation
         };
-        let sin_half = (pose_ab.rotation - q0).length();
         let dt = (pose_ab.translation - p0.translation).length();
-        let reach = self
-            .points
-            .iter()
-            .map(|p| p.local_b.length_squared())
-            .fold(0.0, Real::max)
-            .sqrt();
-        if dt + 2.0 * sin_half * reach <= COHERENCE_DISTANCE {
-            return true;
+        // The bound is at least `dt`: when the translation alone moved further, it cannot
+        // hold, and its chord and reach are not formed (the same decision, cheaper).
+        if dt <= COHERENCE_DISTANCE {
+            let sin_half = (pose_ab.rotation - q0).length();
+            let reach = self
+                .points
+                .iter()
+                .map(|p| p.local_b.length_squared())
+                .fold(0.0, Real::max)
+                .sqrt();
+            if dt + 2.0 * sin_half * reach <= COHERENCE_DISTANCE {
+                return true;
+            }
         }
         // Each point's own displacement `(R - R0) x + Δt`, with the difference of the two
         // rotation matrices formed once (two quaternion rotations per point before).
@@ -438,4 +442,103 @@ fn reduce_points(points: &mut Vec<ContactPoint>) {
     }
     points.clear();
     points.extend_from_slice(&kept[..n]);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::math::Quat;
+
+    /// `is_coherent` as it was, forming the chord and the reach before the bound whatever
+    /// the translation: the oracle of the early exit on the translation alone.
+    fn coherent_reference(m: &ContactManifold, pose_ab: &Isometry) -> bool {
+        let Some(p0) = m.generated_at else {
+            return false;
+        };
+        if m.points.is_empty() {
+            return false;
+        }
+        let cos_half = (0.5 * COHERENCE_ANGLE).cos();
+        if p0.rotation.dot(pose_ab.rotation).abs() < cos_half {
+            return false;
+        }
+        let q0 = if p0.rotation.dot(pose_ab.rotation) < 0.0 {
+            -p0.rotation
+        } else {
+            p0.rotation
+        };
+        let sin_half = (pose_ab.rotation - q0).length();
+        let dt = (pose_ab.translation - p0.translation).length();
+        let reach = m
+            .points
+            .iter()
+            .map(|p| p.local_b.length_squared())
+            .fold(0.0, Real::max)
+            .sqrt();
+        if dt + 2.0 * sin_half * reach <= COHERENCE_DISTANCE {
+            return true;
+        }
+        let dr = Mat3::from_quat(pose_ab.rotation) - Mat3::from_quat(p0.rotation);
+        let dt = pose_ab.translation - p0.translation;
+        m.points
+            .iter()
+            .all(|p| (dr * p.local_b + dt).length_squared() <= COHERENCE_DISTANCE.powi(2))
+    }
+
+    /// Same decisions as the reference: translations below, at and above the tolerance,
+    /// rotations within and beyond the angle, points near and 1 km from B's origin, and
+    /// non-finite poses.
+    #[test]
+    fn coherence_early_exit_keeps_the_decisions() {
+        let mut seed = 0x5851_f42d_4c95_7f2d_u64;
+        let mut rnd = || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as Real / (1u64 << 53) as Real
+        };
+        let (mut yes, mut no) = (0, 0);
+        for case in 0..40000 {
+            let far = if case % 4 == 0 { 1000.0 } else { 1.0 };
+            let p0 = Isometry::new(
+                Vec3::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5) * far,
+                Quat::from_rotation_y(rnd() * 6.0),
+            );
+            let mut m = ContactManifold::new();
+            for _ in 0..1 + case % 4 {
+                let local_b = Vec3::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5);
+                m.points.push(ContactPoint {
+                    distance: 0.0,
+                    normal: Vec3::Y,
+                    point_b: local_b,
+                    local_a: local_b,
+                    local_b,
+                    local_normal_b: Vec3::Y,
+                    feature: 0,
+                    normal_impulse: 0.0,
+                    tangent_impulse: [0.0; 2],
+                    lifetime: 0,
+                });
+            }
+            m.generated_at = Some(p0);
+            let dir = Vec3::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5).normalize();
+            let shift = dir * COHERENCE_DISTANCE * (2.0 * rnd()) * [0.5, 1.0, 1.5][case % 3];
+            let turn = Quat::from_axis_angle(dir, COHERENCE_ANGLE * (rnd() - 0.5) * 0.05);
+            let mut pose = Isometry::new(p0.translation + shift, turn * p0.rotation);
+            if case % 7 == 0 {
+                pose.translation = p0.translation; // rotation only
+            }
+            if case % 997 == 0 {
+                pose.translation.x = Real::NAN;
+            }
+            let want = coherent_reference(&m, &pose);
+            assert_eq!(m.is_coherent(&pose), want, "case {case}");
+            if want {
+                yes += 1;
+            } else {
+                no += 1;
+            }
+        }
+        assert!(yes > 5000 && no > 5000, "{yes} {no}");
+    }
 }
