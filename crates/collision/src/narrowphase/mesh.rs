@@ -36,6 +36,158 @@ pub trait ContactTriangles {
     fn corners(&self, t: u32) -> [Vec3; 3];
     /// Adjacency and convexity of the edges of triangle `t`.
     fn triangle_edges(&self, t: u32) -> [MeshEdge; 3];
+    /// Appends to `out` the triangles [`ContactTriangles::for_each_candidate`] gives for
+    /// `aabb`, in ascending order. [`TriMesh`] answers from a per-thread cache when it can
+    /// (the same triangles: see `QueryCache` in this module).
+    fn candidates_sorted(&self, aabb: &Aabb, out: &mut SmallVec<[u32; 64]>) {
+        let start = out.len();
+        self.for_each_candidate(aabb, &mut |t| out.push(t));
+        out[start..].sort_unstable();
+    }
+}
+
+/// Entries of the per-thread [`QueryCache`]: `CACHE_BUCKETS` buckets of `CACHE_WAYS`.
+const CACHE_BUCKETS: usize = 512;
+/// Entries per bucket of the [`QueryCache`].
+const CACHE_WAYS: usize = 8;
+/// A cache entry holding more triangles than this is not kept (a box that large gains
+/// nothing over the BVH walk).
+const CACHE_MAX_TRIANGLES: usize = 96;
+/// Side of the cells (mesh frame) that pick a query's bucket from its box's centre.
+const CACHE_CELL: Real = 8.0;
+
+/// One cached box query: the triangles of mesh `stamp` whose boxes overlap `big`, ascending,
+/// each with its box (`Aabb::from_points` of its corners, as the midphase's leaf test).
+#[derive(Debug)]
+struct CacheEntry {
+    /// [`TriMesh::stamp`] of the mesh, 0 for an empty entry (stamps start at 1).
+    stamp: u64,
+    big: Aabb,
+    tris: Vec<(u32, Aabb)>,
+}
+
+/// A per-thread cache of mesh box queries for contact generation. parry's shape–trimesh
+/// manifolds (`TriMeshShapeContactManifoldsWorkspace`) keep, per pair, the triangles of a
+/// loosened box and query again only when the shape's box leaves it; here the cache is
+/// keyed by the mesh and the box's position instead of the pair, so it needs no per-pair
+/// storage and no change to the manifolds.
+///
+/// A miss runs the BVH query on the box grown by a margin (`big`) and keeps the result. A
+/// later query on the same mesh whose box lies inside `big` is answered by testing the kept
+/// triangles' boxes against it. That is exactly the set the BVH gives: the midphase returns
+/// the triangles whose own box (`Aabb::from_points`) intersects the query box (its
+/// quantised node boxes are conservative, so none is missed), and a triangle whose box meets
+/// the query box meets `big` too, so it is in the kept list, where the same box test
+/// decides. So the contacts, and the simulation, do not depend on the cache's contents
+/// (which differ between threads). Entries are keyed by the mesh's [`TriMesh::stamp`],
+/// which changes when the mesh is rebuilt or its vertices move.
+///
+/// Memory: the entries are allocated at a thread's first query; an entry's list grows to
+/// the longest it has held (at most [`CACHE_MAX_TRIANGLES`]) and is reused, so the steady
+/// state allocates nothing (as the EPA and clipping scratch buffers).
+struct QueryCache {
+    /// `CACHE_BUCKETS * CACHE_WAYS` entries (empty until the first query).
+    entries: Vec<CacheEntry>,
+    /// Per bucket, the way the next miss replaces (round robin).
+    next: Vec<u8>,
+}
+
+impl QueryCache {
+    fn new() -> QueryCache {
+        QueryCache {
+            entries: Vec::new(),
+            next: Vec::new(),
+        }
+    }
+
+    /// The triangles of `mesh` whose boxes intersect `aabb`, ascending, appended to `out`:
+    /// those of `mesh.view().for_each_triangle_in_aabb(aabb, ..)` sorted.
+    fn candidates(&mut self, mesh: &TriMesh, aabb: &Aabb, out: &mut SmallVec<[u32; 64]>) {
+        let c = aabb.center();
+        let half = aabb.half_extents();
+        let reach = half.max_element();
+        if !(c.is_finite() && reach.is_finite() && reach >= 0.0) {
+            return uncached(mesh, aabb, out);
+        }
+        if self.entries.is_empty() {
+            self.entries
+                .resize_with(CACHE_BUCKETS * CACHE_WAYS, || CacheEntry {
+                    stamp: 0,
+                    big: Aabb::EMPTY,
+                    tris: Vec::new(),
+                });
+            self.next.resize(CACHE_BUCKETS, 0);
+        }
+        let stamp = mesh.stamp();
+        // Truncated cell coordinates (saturating casts; cells near 0 are merged, which
+        // only affects which bucket is used).
+        let cell = (c / CACHE_CELL).to_array().map(|x| x as i32 as u32 as u64);
+        let h = stamp
+            .wrapping_mul(0x9E37_79B9_7F4A_7C15)
+            .wrapping_add(cell[0].wrapping_mul(0xC2B2_AE3D_27D4_EB4F))
+            .wrapping_add(cell[1].wrapping_mul(0x1656_67B1_9E37_79F9))
+            .wrapping_add(cell[2].wrapping_mul(0x27D4_EB2F_1656_67C5));
+        let bucket = ((h >> 32) as usize) % CACHE_BUCKETS;
+        let ways = &mut self.entries[bucket * CACHE_WAYS..(bucket + 1) * CACHE_WAYS];
+        if let Some(e) = ways
+            .iter()
+            .find(|e| e.stamp == stamp && e.big.contains(aabb))
+        {
+            out.extend(
+                e.tris
+                    .iter()
+                    .filter(|(_, b)| b.intersects(aabb))
+                    .map(|&(t, _)| t),
+            );
+            return;
+        }
+        let way = self.next[bucket] as usize;
+        self.next[bucket] = ((way + 1) % CACHE_WAYS) as u8;
+        let e = &mut ways[way];
+        // The margin: half the box's largest half extent plus 5 cm, so a body moving less
+        // than that per step re-uses the entry (a margin twice as large gives fewer misses
+        // but longer lists to filter: the same instruction count on scenes 5 and 6).
+        let big = aabb.expanded(0.05 + 0.5 * reach);
+        e.stamp = 0;
+        e.tris.clear();
+        let mut full = true;
+        mesh.view().for_each_triangle_in_aabb(&big, |t| {
+            if e.tris.len() == CACHE_MAX_TRIANGLES {
+                full = false;
+                return false;
+            }
+            e.tris
+                .push((t, Aabb::from_points(mesh.triangle(t as usize))));
+            true
+        });
+        if !full {
+            e.tris.clear();
+            return uncached(mesh, aabb, out);
+        }
+        e.tris.sort_unstable_by_key(|&(t, _)| t);
+        e.stamp = stamp;
+        e.big = big;
+        out.extend(
+            e.tris
+                .iter()
+                .filter(|(_, b)| b.intersects(aabb))
+                .map(|&(t, _)| t),
+        );
+    }
+}
+
+/// The BVH query of [`QueryCache::candidates`] without the cache.
+fn uncached(mesh: &TriMesh, aabb: &Aabb, out: &mut SmallVec<[u32; 64]>) {
+    let start = out.len();
+    mesh.view().for_each_triangle_in_aabb(aabb, |t| {
+        out.push(t);
+        true
+    });
+    out[start..].sort_unstable();
+}
+
+thread_local! {
+    static QUERY_CACHE: RefCell<QueryCache> = RefCell::new(QueryCache::new());
 }
 
 impl ContactTriangles for TriMesh {
@@ -52,6 +204,13 @@ impl ContactTriangles for TriMesh {
     #[inline]
     fn triangle_edges(&self, t: u32) -> [MeshEdge; 3] {
         self.edges()[t as usize]
+    }
+    fn candidates_sorted(&self, aabb: &Aabb, out: &mut SmallVec<[u32; 64]>) {
+        QUERY_CACHE.with(|cell| match cell.try_borrow_mut() {
+            Ok(mut cache) => cache.candidates(self, aabb, out),
+            // A re-entrant call (none in the library) skips the cache.
+            Err(_) => uncached(self, aabb, out),
+        });
     }
 }
 
@@ -293,8 +452,7 @@ fn contacts_in_box<M: ContactTriangles + ?Sized>(
     // Triangles in index order, so a mesh and a heightfield with the same triangles give
     // the same sequence of points (and the same reduced manifold).
     let mut tris: SmallVec<[u32; 64]> = SmallVec::new();
-    mesh.for_each_candidate(aabb, &mut |t| tris.push(t));
-    tris.sort_unstable();
+    mesh.candidates_sorted(aabb, &mut tris);
     for t in tris {
         let [p, q, r] = mesh.corners(t);
         let tri = Triangle { a: p, b: q, c: r };

@@ -157,3 +157,146 @@ fn hull_box_cull_only_skips_triangles_beyond_the_prediction() {
     }
     assert!(culled > 1000 && kept > 1000, "culled {culled}, kept {kept}");
 }
+
+/// A bumpy `n × n` grid of cells (two triangles each) of side `h`, shifted by `offset`,
+/// with some collapsed triangles (a repeated corner: zero area) and random heights.
+fn bumpy_grid(rng: &mut Rng, n: usize, h: Real, offset: Vec3) -> TriMesh {
+    let mut vertices = Vec::new();
+    for i in 0..=n {
+        for j in 0..=n {
+            let y = if (i + j).is_multiple_of(5) {
+                0.0
+            } else {
+                rng.range(-0.5, 0.5)
+            };
+            vertices.push(offset + Vec3::new(i as Real * h, y, j as Real * h));
+        }
+    }
+    let at = |i: usize, j: usize| (i * (n + 1) + j) as u32;
+    let mut indices = Vec::new();
+    for i in 0..n {
+        for j in 0..n {
+            indices.push([at(i, j), at(i, j + 1), at(i + 1, j)]);
+            if (i * n + j).is_multiple_of(11) {
+                indices.push([at(i + 1, j), at(i, j + 1), at(i, j + 1)]);
+            } else {
+                indices.push([at(i + 1, j), at(i, j + 1), at(i + 1, j + 1)]);
+            }
+        }
+    }
+    TriMesh::new(vertices, indices).unwrap()
+}
+
+/// Brute force: every triangle whose box (`Aabb::from_points`, the midphase's leaf test)
+/// intersects `aabb`, ascending.
+fn brute_candidates(mesh: &TriMesh, aabb: &Aabb) -> Vec<u32> {
+    (0..mesh.num_triangles() as u32)
+        .filter(|&t| Aabb::from_points(mesh.triangle(t as usize)).intersects(aabb))
+        .collect()
+}
+
+fn cached(mesh: &TriMesh, aabb: &Aabb) -> Vec<u32> {
+    let mut out = SmallVec::new();
+    mesh.candidates_sorted(aabb, &mut out);
+    out.to_vec()
+}
+
+#[test]
+fn cached_mesh_queries_equal_the_bvh_and_brute_force() {
+    let mut rng = Rng(0x9E37_79B9_7F4A_7C15);
+    for (offset, h) in [
+        (Vec3::ZERO, 1.0),
+        (Vec3::new(1.0e3, -20.0, -1.0e3), 2.0),
+        (Vec3::new(-3.0, 0.0, -3.0), 0.25),
+    ] {
+        let mesh = bumpy_grid(&mut rng, 24, h, offset);
+        let span = 24.0 * h;
+        let (mut found, mut total) = (0usize, 0usize);
+        // Bodies walking over the mesh: small steps (cache hits), jumps (misses), sizes from
+        // zero to larger than the cache keeps.
+        for _ in 0..40 {
+            let mut c = offset + Vec3::new(rng.range(0.0, span), 0.0, rng.range(0.0, span));
+            let half = match rng.range(0.0, 1.0) {
+                x if x < 0.1 => Vec3::ZERO,
+                x if x < 0.2 => Vec3::splat(0.3 * span),
+                _ => {
+                    Vec3::new(
+                        rng.range(0.0, 2.0),
+                        rng.range(0.0, 1.0),
+                        rng.range(0.0, 2.0),
+                    ) * h
+                }
+            };
+            for step in 0..30 {
+                let jump = if step % 10 == 9 { 3.0 } else { 0.05 };
+                c += Vec3::new(
+                    rng.range(-1.0, 1.0),
+                    rng.range(-0.2, 0.2),
+                    rng.range(-1.0, 1.0),
+                ) * jump
+                    * h;
+                let aabb = Aabb::from_center_half_extents(c, half);
+                let want = brute_candidates(&mesh, &aabb);
+                let mut bvh = Vec::new();
+                mesh.view().triangles_in_aabb(&aabb, &mut bvh);
+                assert_eq!(bvh, want, "the BVH query is the brute force");
+                assert_eq!(cached(&mesh, &aabb), want, "box {aabb:?}");
+                total += 1;
+                found += usize::from(!want.is_empty());
+            }
+        }
+        assert!(
+            found > total / 2,
+            "{found} of {total} queries found triangles"
+        );
+        // A box touching triangles' boxes exactly (a face shared with a vertex's coordinate).
+        for t in (0..mesh.num_triangles()).step_by(37) {
+            let b = Aabb::from_points(mesh.triangle(t));
+            let touch = Aabb::new(b.max, b.max + Vec3::splat(0.1 * h));
+            assert_eq!(cached(&mesh, &touch), brute_candidates(&mesh, &touch));
+            assert!(cached(&mesh, &touch).contains(&(t as u32)));
+            let inner = Aabb::from_center_half_extents(b.center(), Vec3::ZERO);
+            assert_eq!(cached(&mesh, &inner), brute_candidates(&mesh, &inner));
+        }
+        // Non-finite and inverted boxes go to the BVH.
+        let nan = Aabb::new(Vec3::splat(Real::NAN), Vec3::splat(Real::NAN));
+        let mut bvh = Vec::new();
+        mesh.view().triangles_in_aabb(&nan, &mut bvh);
+        assert_eq!(cached(&mesh, &nan), bvh);
+        let inverted = Aabb::new(offset + Vec3::splat(2.0), offset + Vec3::splat(1.0));
+        let mut bvh = Vec::new();
+        mesh.view().triangles_in_aabb(&inverted, &mut bvh);
+        assert_eq!(cached(&mesh, &inverted), bvh);
+    }
+}
+
+#[test]
+fn cached_mesh_queries_follow_moved_vertices_and_clones() {
+    let mut rng = Rng(0x2545_F491_4F6C_DD1D);
+    let mut mesh = bumpy_grid(&mut rng, 16, 1.0, Vec3::ZERO);
+    let aabb = Aabb::from_center_half_extents(Vec3::new(8.2, 0.0, 8.3), Vec3::splat(0.6));
+    let before = cached(&mesh, &aabb);
+    assert_eq!(before, brute_candidates(&mesh, &aabb));
+    assert!(!before.is_empty());
+    // The same box again (now from the cache), then on a clone (same contents, same stamp).
+    assert_eq!(cached(&mesh, &aabb), before);
+    let copy = mesh.clone();
+    assert_eq!(cached(&copy, &aabb), before);
+    // Move the vertices away: the cached entry must not answer for the moved mesh.
+    let moved: Vec<Vec3> = mesh
+        .vertices()
+        .iter()
+        .map(|v| *v + Vec3::new(5.0, 0.0, 0.0))
+        .collect();
+    mesh.set_vertices(moved).unwrap();
+    let after = cached(&mesh, &aabb);
+    assert_eq!(after, brute_candidates(&mesh, &aabb));
+    assert_ne!(after, before);
+    // The unmoved clone still answers with its own triangles.
+    assert_eq!(cached(&copy, &aabb), before);
+    // A mesh deserialised from the clone gets a stamp of its own and the same answers.
+    let bytes = postcard::to_allocvec(&copy).unwrap();
+    let back: TriMesh = postcard::from_bytes(&bytes).unwrap();
+    assert_eq!(back, copy);
+    assert_eq!(cached(&back, &aabb), before);
+}

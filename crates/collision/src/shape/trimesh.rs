@@ -46,6 +46,39 @@ pub struct TriMesh {
     bvh: Bvh,
     edges: Vec<[MeshEdge; 3]>,
     flat_angle: Real,
+    /// Identifies this mesh's current contents for caches of its queries (not serialised,
+    /// ignored by `==`).
+    #[serde(skip)]
+    stamp: MeshStamp,
+}
+
+/// A process-wide unique number given to a [`TriMesh`] when it is built, deserialised or
+/// changed ([`TriMesh::set_vertices`]); a clone keeps it (same contents). The narrowphase's
+/// per-thread box-query cache (`narrowphase::mesh`) keys its entries by it, so an entry can
+/// never serve another mesh, or this mesh after its vertices moved. Equality ignores it.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct MeshStamp(u64);
+
+impl MeshStamp {
+    /// A number no other mesh has had in this process.
+    fn fresh() -> MeshStamp {
+        use std::sync::atomic::{AtomicU64, Ordering};
+        static NEXT: AtomicU64 = AtomicU64::new(1);
+        MeshStamp(NEXT.fetch_add(1, Ordering::Relaxed))
+    }
+}
+
+impl Default for MeshStamp {
+    fn default() -> Self {
+        MeshStamp::fresh()
+    }
+}
+
+impl PartialEq for MeshStamp {
+    /// Always true: two meshes are equal by their contents.
+    fn eq(&self, _: &MeshStamp) -> bool {
+        true
+    }
 }
 
 /// The serialised form of a [`TriMesh`], checked on load by `TryFrom`: the vertices and
@@ -105,6 +138,7 @@ fn check_data(d: TriMeshData) -> Result<TriMesh> {
             bvh: d.bvh,
             edges: d.edges,
             flat_angle: d.flat_angle,
+            stamp: MeshStamp::fresh(),
         })
     }
 }
@@ -172,6 +206,7 @@ impl TriMesh {
             bvh,
             edges,
             flat_angle: options.flat_angle,
+            stamp: MeshStamp::fresh(),
         })
     }
 
@@ -190,7 +225,14 @@ impl TriMesh {
         self.edges = compute_edges(&vertices, &self.indices, self.flat_angle);
         self.local_aabb = self.bvh.root_aabb();
         self.vertices = vertices;
+        self.stamp = MeshStamp::fresh();
         Ok(())
+    }
+
+    /// The number identifying this mesh's current contents (see [`MeshStamp`]).
+    #[inline]
+    pub(crate) fn stamp(&self) -> u64 {
+        self.stamp.0
     }
 
     /// The vertices.
