@@ -13,7 +13,7 @@
 //!
 //! The lanes hold the binary nodes' boxes bit for bit and the comparisons are the ones of
 //! [`Aabb::intersects`] (touching counts), so a query reports exactly the leaves the binary
-//! [`DynamicTree::overlapping_leaves`] reports (in another order).
+//! `DynamicTree::overlapping_leaves` reports (in another order).
 
 use super::dynamic_tree::{DynamicTree, NULL};
 use crate::math::{Aabb, Real};
@@ -142,7 +142,7 @@ impl WideTree {
 
     /// Calls `f(user)` for every leaf whose box intersects `aabb` (touching counts), with a
     /// caller-owned stack (cleared first): the leaves of
-    /// [`DynamicTree::overlapping_leaves`] on the tree this copy was rebuilt from.
+    /// `DynamicTree::overlapping_leaves` on the tree this copy was rebuilt from.
     #[inline]
     pub fn overlapping_leaves(&self, aabb: &Aabb, stack: &mut Vec<u32>, mut f: impl FnMut(u32)) {
         stack.clear();
