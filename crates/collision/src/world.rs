@@ -287,8 +287,12 @@ impl CollisionWorld {
     ) -> Result<()> {
         let i = self.slot(h)?;
         let pose = check_pose_fast(pose)?;
-        let margin = crate::math::check_non_negative("margin", margin)?;
-        let motion = crate::math::check_finite_vec("motion", motion)?;
+        // One test for the usual case; the named checks (which build the errors) only when
+        // it fails.
+        if !(margin.is_finite() && margin >= 0.0 && motion.is_finite()) {
+            crate::math::check_non_negative("margin", margin)?;
+            crate::math::check_finite_vec("motion", motion)?;
+        }
         let Some(o) = self.objects[i].as_mut() else {
             return Err(CaromError::UnknownHandle(format!("{h:?}")));
         };
@@ -296,9 +300,16 @@ impl CollisionWorld {
         let displacement = pose.translation - o.pose.translation;
         // A pose far out can overflow the box or the displacement: checked before anything
         // changes, so the broadphase can take them unchecked (the handle is live: an object
-        // and its proxy share it).
-        crate::math::check_aabb(&aabb)?;
-        crate::math::check_finite_vec("displacement", displacement)?;
+        // and its proxy share it). The fast test is `check_aabb`'s and `check_finite_vec`'s
+        // condition.
+        if !(aabb.min.is_finite()
+            && aabb.max.is_finite()
+            && aabb.min.cmple(aabb.max).all()
+            && displacement.is_finite())
+        {
+            crate::math::check_aabb(&aabb)?;
+            crate::math::check_finite_vec("displacement", displacement)?;
+        }
         self.broadphase
             .update_proxy_checked(h.proxy(), &aabb, displacement)?;
         o.pose = pose;

@@ -5,6 +5,7 @@ mod broadphase_common;
 
 use broadphase_common::{moved_box, random_box, Rng, Scene, SCENES};
 use carom_collision::broadphase::{DynamicTree, HalfSpace, InsertStrategy, TreeProxy};
+use carom_collision::bvh::WideTree;
 use carom_collision::math::{Aabb, Real, Vec3};
 use std::collections::BTreeSet;
 
@@ -203,6 +204,75 @@ fn plane_query_matches_brute_force() {
     }
 }
 
+/// The leaves (user data) of the 4-wide copy's box query, sorted, with no duplicate.
+fn wide_hits(wide: &WideTree, q: &Aabb, stack: &mut Vec<u32>) -> Vec<u32> {
+    let mut got = Vec::new();
+    wide.overlapping_leaves(q, stack, |u| got.push(u));
+    let n = got.len();
+    got.sort_unstable();
+    got.dedup();
+    assert_eq!(got.len(), n, "a leaf reported twice");
+    got
+}
+
+#[test]
+fn wide_tree_query_matches_brute_force() {
+    // Random boxes, every leaf's own fat box, zero-size boxes at fat-box corners and boxes
+    // touching a fat box's face only, on uniform, mixed-size, far (1e5) and lattice
+    // (zero extents, touching faces) trees, against the brute force over the fat boxes.
+    let mut stack = Vec::new();
+    let mut wide = WideTree::new();
+    for s in STRATEGIES {
+        for (k, &scene) in SCENES.iter().enumerate() {
+            let (tree, leaves) = churn(s, scene, 40 + k as u64, 160);
+            let all = fat_boxes(&tree, &leaves);
+            wide.rebuild(&tree);
+            assert!(wide.node_count() <= tree.len());
+            let mut rng = Rng(77 + k as u64);
+            let mut queries: Vec<Aabb> = (0..40).map(|_| random_box(&mut rng, scene)).collect();
+            for e in &all {
+                let b = e.1;
+                queries.push(b);
+                queries.push(Aabb::new(b.max, b.max));
+                queries.push(Aabb::new(b.min, b.min));
+                let w = b.max.x - b.min.x;
+                let face = Vec3::new(b.max.x, b.min.y, b.min.z);
+                queries.push(Aabb::new(face, face + Vec3::new(w + 1.0, 0.0, 0.0)));
+            }
+            let mut hits = 0;
+            for q in &queries {
+                let expect: Vec<u32> = {
+                    let mut v: Vec<u32> = all
+                        .iter()
+                        .filter(|e| e.1.intersects(q))
+                        .map(|e| e.2)
+                        .collect();
+                    v.sort_unstable();
+                    v
+                };
+                assert_eq!(wide_hits(&wide, q, &mut stack), expect, "{scene:?} {q:?}");
+                hits += expect.len();
+            }
+            assert!(hits > queries.len(), "{scene:?}: {hits} hits");
+        }
+    }
+    // An empty tree and a single leaf.
+    let mut tree = DynamicTree::new(InsertStrategy::SurfaceArea, 0.0);
+    wide.rebuild(&tree);
+    let unit = Aabb::new(Vec3::ZERO, Vec3::ONE);
+    assert!(wide_hits(&wide, &unit, &mut stack).is_empty());
+    let l = tree.create_proxy(unit, 9).unwrap();
+    wide.rebuild(&tree);
+    assert_eq!(wide_hits(&wide, &unit, &mut stack), vec![9]);
+    let touching = Aabb::new(Vec3::ONE, Vec3::splat(2.0));
+    assert_eq!(wide_hits(&wide, &touching, &mut stack), vec![9]);
+    let apart = Aabb::new(Vec3::splat(1.5), Vec3::splat(2.0));
+    assert!(wide_hits(&wide, &apart, &mut stack).is_empty());
+    tree.destroy_proxy(l).unwrap();
+    wide.rebuild(&tree);
+    assert!(wide_hits(&wide, &unit, &mut stack).is_empty());
+}
+
 #[test]
 fn tree_vs_tree_and_self_pairs_match_brute_force() {
     for s in STRATEGIES {
@@ -397,10 +467,19 @@ fn refitting_and_reinserting_two_tree_broadphases_report_the_brute_force_pairs()
     for (k, &scene) in SCENES.iter().enumerate() {
         let mut rng = Rng(1300 + k as u64);
         let mut variants: Vec<TreeBroadPhase> = Vec::new();
-        for (refit, margin, scale) in [(true, 0.05, 4.0), (false, 0.05, 4.0), (true, 0.1, 2.0)] {
+        // The last two take the moved proxies' queries on the 4-wide copy of the moving
+        // tree whenever keys were found before (0) or never (infinity).
+        for (refit, margin, scale, wide) in [
+            (true, 0.05, 4.0, 1.0),
+            (false, 0.05, 4.0, 1.0),
+            (true, 0.1, 2.0, 1.0),
+            (true, 0.05, 4.0, 0.0),
+            (true, 0.05, 4.0, Real::INFINITY),
+        ] {
             let mut t = TreeBroadPhase::new(InsertStrategy::SurfaceArea, margin);
             t.refit_moving = refit;
             t.set_motion_scale(scale);
+            t.wide_query_keys = wide;
             variants.push(t);
         }
         let mut oracle = BruteForce::new();

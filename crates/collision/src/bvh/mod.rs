@@ -9,6 +9,7 @@
 //! - [`DynamicTree`]: the incrementally updated AABB tree of Bullet's `btDbvt` and Box2D's
 //!   `b2DynamicTree`. The tree broadphase is built on it, and compound shapes keep their
 //!   children in one (Bullet's `btCompoundShape`), so children can be added, moved and removed.
+//!   [`WideTree`] is its 4-wide copy for batches of box queries (the broadphase's moved proxies).
 //!
 //! The module sits right after `math` and before `shape`: shapes own hierarchies, and both
 //! the broadphase and the midphase query them, so the structures cannot live in either.
@@ -22,6 +23,7 @@ mod traverse;
 mod tree_insert;
 mod tree_query;
 mod tree_validate;
+mod tree_wide;
 mod wide;
 
 pub use build::{MAX_LEAF_SIZE, NUM_BINS};
@@ -29,4 +31,5 @@ pub use dynamic_tree::{DynamicTree, InsertStrategy, TreeProxy};
 pub use quantize::Quantization;
 pub use static_bvh::{Bvh, BvhLayout, QuantizedNode, UnquantizedNode, MAX_PRIMITIVES};
 pub use tree_query::HalfSpace;
+pub use tree_wide::WideTree;
 pub use wide::WideNode;
