@@ -115,15 +115,23 @@ impl Sink<'_> {
 const EQUALITY: fn() -> (RowKind, Real) = || (RowKind::Equality, 0.0);
 const INEQUALITY: fn() -> (RowKind, Real) = || (RowKind::Inequality, 0.0);
 
-/// Emits the rows of a joint of type `kind` at frames `f`; `h` is the substep.
+/// Whether a joint of type `kind` holds B's anchor on A's (ball, hinge, cone-twist,
+/// fixed): that part is not emitted as rows but solved as one world-frame
+/// [`PointBlock`](crate::solver::rows::PointBlock) built from the same frames.
+pub(super) fn has_point(kind: &JointKind) -> bool {
+    matches!(
+        kind,
+        JointKind::Ball | JointKind::Fixed | JointKind::Hinge { .. } | JointKind::ConeTwist { .. }
+    )
+}
+
+/// Emits the rows of a joint of type `kind` at frames `f`; `h` is the substep. The point
+/// part of the joints for which [`has_point`] holds is left to their point block.
 pub(super) fn generate(kind: &JointKind, f: &Frames, h: Real, sink: &mut Sink) {
     let lock = Axis::default();
     match *kind {
-        JointKind::Ball => locked_point(f, sink),
-        JointKind::Fixed => {
-            locked_point(f, sink);
-            angular_axes(f, &[lock; 3], h, sink);
-        }
+        JointKind::Ball => {}
+        JointKind::Fixed => angular_axes(f, &[lock; 3], h, sink),
         JointKind::Slider { limits, motor } => {
             let x = Axis {
                 mode: limited(limits),
@@ -140,18 +148,12 @@ pub(super) fn generate(kind: &JointKind, f: &Frames, h: Real, sink: &mut Sink) {
             linear_axes(f, linear, h, sink);
             angular_axes(f, angular, h, sink);
         }
-        JointKind::Hinge { limits, motor } => {
-            locked_point(f, sink);
-            hinge(f, limits, motor, h, sink);
-        }
+        JointKind::Hinge { limits, motor } => hinge(f, limits, motor, h, sink),
         JointKind::ConeTwist {
             swing1,
             swing2,
             twist,
-        } => {
-            locked_point(f, sink);
-            cone_twist(f, swing1, swing2, twist, sink);
-        }
+        } => cone_twist(f, swing1, swing2, twist, sink),
     }
 }
 
@@ -201,16 +203,6 @@ fn linear_axes(f: &Frames, axes: &[Axis; 3], h: Real, sink: &mut Sink) {
         axis_rows(3 * i, ax, value, h, sink, |s, slot, sign, c, kind| {
             s.linear(slot, axis * sign, f, c, kind)
         });
-    }
-}
-
-/// [`linear_axes`] with the three axes locked (ball, hinge, cone-twist, fixed): the same
-/// three equality rows, written without the per-axis mode dispatch.
-#[inline]
-fn locked_point(f: &Frames, sink: &mut Sink) {
-    for i in 0..3 {
-        let axis = f.axis_a(i);
-        sink.linear(3 * i, axis, f, f.d.dot(axis), EQUALITY);
     }
 }
 
