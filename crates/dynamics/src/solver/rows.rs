@@ -165,8 +165,13 @@ impl Row {
     pub fn finish(&mut self, p: &PairInertia) {
         self.ia = PairInertia::mul(&p.a, self.ang_a);
         self.ib = PairInertia::mul(&p.b, self.ang_b);
-        let k =
-            p.inv_m * self.lin.length_squared() + self.ang_a.dot(self.ia) + self.ang_b.dot(self.ib);
+        let angular = self.ang_a.dot(self.ia) + self.ang_b.dot(self.ib);
+        // An angular row's linear term is zero (adding it changes at most a zero's sign).
+        let k = if self.angular {
+            angular
+        } else {
+            p.inv_m * self.lin.length_squared() + angular
+        };
         self.inv_k = inv_or_zero(k);
     }
 
@@ -289,8 +294,16 @@ impl Block {
         }
         // The six entries of the symmetric K, padded with the identity past `len`.
         let inv_m = p.inv_m;
+        // Angular rows (zero `lin`, as the hinge's alignment rows and a fixed joint's
+        // rotation) leave out the zero linear term.
+        let linear = rows.iter().any(|r| !r.angular);
         let e = |ri: &Row, rj: &Row| {
-            inv_m * ri.lin.dot(rj.lin) + ri.ang_a.dot(rj.ia) + ri.ang_b.dot(rj.ib)
+            let angular = ri.ang_a.dot(rj.ia) + ri.ang_b.dot(rj.ib);
+            if linear {
+                inv_m * ri.lin.dot(rj.lin) + angular
+            } else {
+                angular
+            }
         };
         let (k00, k01, k02, k11, k12, k22) = match rows {
             [r0, r1, r2] => (
