@@ -11,7 +11,8 @@
 //! Rows are built in two phases, as Box2D v3 / box3d split `b3PrepareJoint` from the
 //! substep solves: [`prepare_joint`] runs once per step and fixes everything that does not
 //! move — which rows exist, their kinds, bounds, slots and warm-start impulses, which runs
-//! form blocks, and the anchors and frame rotations in the bodies' centre-of-mass frames;
+//! form blocks, the world-frame point block of the joints that hold B's anchor on A's
+//! ([`PointBlock`]), and the anchors and frame rotations in the bodies' centre-of-mass frames;
 //! [`refresh_own`] runs after every position update of the soft step and only rotates the
 //! anchors and axes by the current body rotations, recomputes the errors, and updates the
 //! effective masses (with the step's fixed inverse inertias). Both run the same generator

@@ -6,8 +6,9 @@
 //! Both solve the joints before the contacts of each iteration (Bullet solves non-contact
 //! constraints first as well). The colouring depends only on the joint set and
 //! which bodies move, so the order — and every bit of the result — is the same for any
-//! thread count. Runs of equality rows (a ball joint's point, a fixed joint's rotation) are
-//! solved as coupled blocks ([`Block`]).
+//! thread count. The point of a ball, hinge, cone-twist or fixed joint is one world-frame
+//! 3×3 block ([`PointBlock`], solved first); runs of the other equality rows (a hinge's
+//! alignment, a fixed joint's rotation) are solved as coupled blocks ([`Block`]).
 //!
 //! The rows live in the world-owned [`JointScratch`]: [`prepare`] fills it once per step
 //! in colour order (no allocation once the buffers have grown to the joint count), and the
