@@ -63,6 +63,11 @@ fn kinds() -> Vec<JointKind> {
             swing2: 0.3,
             twist: 0.2,
         },
+        JointKind::ConeTwist {
+            swing1: 0.5,
+            swing2: 0.3,
+            twist: 0.0,
+        },
         JointKind::Slider {
             limits: Some((-0.5, 0.5)),
             motor,
@@ -227,8 +232,8 @@ fn refresh_equals_a_fresh_preparation_for_every_joint_type() {
 #[test]
 fn row_counts_follow_the_joint_description() {
     // Rows besides the point block (ball, fixed, hinges, cone-twist have one).
-    let counts = [0, 3, 2, 5, 3, 8, 10];
-    let points = [true, true, true, true, true, false, false];
+    let counts = [0, 3, 2, 5, 3, 2, 8, 10];
+    let points = [true, true, true, true, true, true, false, false];
     for ((kind, n), point) in kinds().into_iter().zip(counts).zip(points) {
         let r = rig(kind, Vec3::ZERO);
         let mut bodies = Vec::new();
