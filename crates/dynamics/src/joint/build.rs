@@ -11,7 +11,8 @@
 //! Rows are built in two phases, as Box2D v3 / box3d split `b3PrepareJoint` from the
 //! substep solves: [`prepare_joint`] runs once per step and fixes everything that does not
 //! move — which rows exist, their kinds, bounds, slots and warm-start impulses, which runs
-//! form blocks, and the anchors and frame rotations in the bodies' centre-of-mass frames;
+//! form blocks, the world-frame point block of the joints that hold B's anchor on A's
+//! ([`PointBlock`]), and the anchors and frame rotations in the bodies' centre-of-mass frames;
 //! [`refresh_own`] runs after every position update of the soft step and only rotates the
 //! anchors and axes by the current body rotations, recomputes the errors, and updates the
 //! effective masses (with the step's fixed inverse inertias). Both run the same generator
@@ -19,10 +20,10 @@
 //! the Jacobian and error of the next existing one, so the two cannot disagree on the row
 //! order.
 
-use super::generate::{generate, Frames, Sink};
+use super::generate::{generate, has_point, Frames, Sink};
 use super::Joint;
 use crate::body_set::BodySet;
-use crate::solver::rows::{Block, PairInertia, Row, RowKind};
+use crate::solver::rows::{Block, PairInertia, PointBlock, Row, RowKind};
 use crate::solver::SolverBody;
 use carom_collision::math::{Mat3, Quat, Real, Vec3, Vec3A};
 use std::ops::Range;
@@ -46,6 +47,9 @@ pub(crate) struct JointRows {
     /// The joint has a finite `break_impulse`: only then does the soft step sum its rows'
     /// substep impulses for breaking.
     pub breakable: bool,
+    /// The world-frame point block of a ball, hinge, cone-twist or fixed joint (solved
+    /// before the rows), holding what were its first three rows (slots 0, 3, 6).
+    pub point: Option<PointBlock>,
     /// Anchor of frame A relative to A's centre of mass, in A's body axes (box3d's
     /// `frameA.p = rot(q, f.p - localCenter)` before the rotation).
     local_a: Vec3,
@@ -128,8 +132,16 @@ pub(crate) fn prepare_joint(
         local_b: desc.frame_b.translation - set.info[b].local_com,
         frame_qa: desc.frame_a.rotation,
         frame_qb: desc.frame_b.rotation,
+        point: None,
     };
     let f = jr.frames(set);
+    if has_point(&desc.kind) {
+        let mut p = PointBlock::new(f.ra, f.rb, f.d, f.axes_a);
+        // The stored slot impulses are components along frame A's axes.
+        let s = |k: usize| joint.impulses[k] * impulse_in;
+        p.impulse = f.axes_a[0] * s(0) + f.axes_a[1] * s(3) + f.axes_a[2] * s(6);
+        jr.point = Some(p);
+    }
     generate(&desc.kind, &f, h, &mut Sink::Append(rows));
     jr.rows = row_start..rows.len();
     let own = &mut rows[jr.rows.clone()];
@@ -152,7 +164,7 @@ pub(crate) fn prepare_joint(
     }
     jr.blocks = block_start..blocks.len();
     if with_masses {
-        masses(&jr, rows, blocks, bodies);
+        masses(&mut jr, rows, blocks, bodies);
     }
     Some(jr)
 }
@@ -160,7 +172,7 @@ pub(crate) fn prepare_joint(
 /// [`refresh_own`] on the shared buffers (tests).
 #[cfg(test)]
 pub(crate) fn refresh_joint(
-    jr: &JointRows,
+    jr: &mut JointRows,
     joint: &Joint,
     set: &BodySet,
     bodies: &[SolverBody],
@@ -168,15 +180,8 @@ pub(crate) fn refresh_joint(
     blocks: &mut [Block],
 ) {
     let (own, own_blocks) = (&mut rows[jr.rows.clone()], &mut blocks[jr.blocks.clone()]);
-    refresh_own(
-        jr,
-        joint,
-        set,
-        &bodies[jr.a],
-        &bodies[jr.b],
-        own,
-        own_blocks,
-    );
+    let (sa, sb) = (&bodies[jr.a], &bodies[jr.b]);
+    refresh_own(jr, joint, set, sa, sb, own, own_blocks);
 }
 
 /// Updates the rows of `jr` from the bodies' *current* poses (the soft step moves them every
@@ -190,7 +195,7 @@ pub(crate) fn refresh_joint(
 /// `jr.blocks` of the shared buffers), so the joints of one colour may be refreshed at the
 /// same time.
 pub(crate) fn refresh_own(
-    jr: &JointRows,
+    jr: &mut JointRows,
     joint: &Joint,
     set: &BodySet,
     sa: &SolverBody,
@@ -199,17 +204,22 @@ pub(crate) fn refresh_own(
     own_blocks: &mut [Block],
 ) {
     let f = jr.frames(set);
+    if let Some(p) = &mut jr.point {
+        p.set(f.ra, f.rb, f.d, f.axes_a);
+    }
     let mut sink = Sink::Overwrite(own, 0);
     // `h` only sizes motor bounds and spring softness, which an overwrite keeps.
     generate(&joint.desc.kind, &f, 0.0, &mut sink);
     debug_assert!(matches!(sink, Sink::Overwrite(r, n) if n == r.len()));
-    masses_own(own, own_blocks, sa, sb);
+    masses_own(jr.point.as_mut(), own, own_blocks, sa, sb);
 }
 
-/// Effective masses: each block's `K⁻¹`, the scalar mass of every other row.
-fn masses(jr: &JointRows, rows: &mut [Row], blocks: &mut [Block], bodies: &[SolverBody]) {
+/// Effective masses: the point block's and each block's `K⁻¹`, the scalar mass of every
+/// other row.
+fn masses(jr: &mut JointRows, rows: &mut [Row], blocks: &mut [Block], bodies: &[SolverBody]) {
     let (sa, sb) = (&bodies[jr.a], &bodies[jr.b]);
     masses_own(
+        jr.point.as_mut(),
         &mut rows[jr.rows.clone()],
         &mut blocks[jr.blocks.clone()],
         sa,
@@ -217,11 +227,20 @@ fn masses(jr: &JointRows, rows: &mut [Row], blocks: &mut [Block], bodies: &[Solv
     );
 }
 
-/// [`masses`] on one joint's own rows and blocks (`own`, `blocks`: the joint's ranges of
-/// the shared buffers) with its bodies `sa`, `sb`.
+/// [`masses`] on one joint's point block, own rows and blocks (`own`, `blocks`: the joint's
+/// ranges of the shared buffers) with its bodies `sa`, `sb`.
 #[inline]
-pub(crate) fn masses_own(own: &mut [Row], blocks: &mut [Block], sa: &SolverBody, sb: &SolverBody) {
+pub(crate) fn masses_own(
+    point: Option<&mut PointBlock>,
+    own: &mut [Row],
+    blocks: &mut [Block],
+    sa: &SolverBody,
+    sb: &SolverBody,
+) {
     let p = PairInertia::of(sa, sb);
+    if let Some(point) = point {
+        point.update(&p);
+    }
     let mut i = 0;
     for block in blocks {
         for row in &mut own[i..block.start] {

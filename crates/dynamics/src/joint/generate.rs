@@ -68,15 +68,13 @@ impl Sink<'_> {
         }
     }
 
-    /// An inequality row that does nothing at this pose: zero Jacobian, zero error and
-    /// zero impulse (a row that would be absent).
+    /// A row of kind `kind` (an inequality or equality row) that does nothing at this pose:
+    /// zero Jacobian, zero error and zero impulse (a row that would be absent).
     #[inline]
-    fn put_inactive(&mut self, slot: usize) {
+    fn put_inactive(&mut self, slot: usize, kind: RowKind) {
         let zero = [Vec3A::ZERO; 3];
         match self {
-            Sink::Append(rows) => {
-                rows.push(Row::new(slot as u8, zero, 0.0, RowKind::Inequality, 0.0))
-            }
+            Sink::Append(rows) => rows.push(Row::new(slot as u8, zero, 0.0, kind, 0.0)),
             Sink::Overwrite(rows, i) => {
                 if let Some(row) = rows.get_mut(*i) {
                     row.set(zero, 0.0);
@@ -115,15 +113,23 @@ impl Sink<'_> {
 const EQUALITY: fn() -> (RowKind, Real) = || (RowKind::Equality, 0.0);
 const INEQUALITY: fn() -> (RowKind, Real) = || (RowKind::Inequality, 0.0);
 
-/// Emits the rows of a joint of type `kind` at frames `f`; `h` is the substep.
+/// Whether a joint of type `kind` holds B's anchor on A's (ball, hinge, cone-twist,
+/// fixed): that part is not emitted as rows but solved as one world-frame
+/// [`PointBlock`](crate::solver::rows::PointBlock) built from the same frames.
+pub(super) fn has_point(kind: &JointKind) -> bool {
+    matches!(
+        kind,
+        JointKind::Ball | JointKind::Fixed | JointKind::Hinge { .. } | JointKind::ConeTwist { .. }
+    )
+}
+
+/// Emits the rows of a joint of type `kind` at frames `f`; `h` is the substep. The point
+/// part of the joints for which [`has_point`] holds is left to their point block.
 pub(super) fn generate(kind: &JointKind, f: &Frames, h: Real, sink: &mut Sink) {
     let lock = Axis::default();
     match *kind {
-        JointKind::Ball => locked_point(f, sink),
-        JointKind::Fixed => {
-            locked_point(f, sink);
-            angular_axes(f, &[lock; 3], h, sink);
-        }
+        JointKind::Ball => {}
+        JointKind::Fixed => angular_axes(f, &[lock; 3], h, sink),
         JointKind::Slider { limits, motor } => {
             let x = Axis {
                 mode: limited(limits),
@@ -140,18 +146,12 @@ pub(super) fn generate(kind: &JointKind, f: &Frames, h: Real, sink: &mut Sink) {
             linear_axes(f, linear, h, sink);
             angular_axes(f, angular, h, sink);
         }
-        JointKind::Hinge { limits, motor } => {
-            locked_point(f, sink);
-            hinge(f, limits, motor, h, sink);
-        }
+        JointKind::Hinge { limits, motor } => hinge(f, limits, motor, h, sink),
         JointKind::ConeTwist {
             swing1,
             swing2,
             twist,
-        } => {
-            locked_point(f, sink);
-            cone_twist(f, swing1, swing2, twist, sink);
-        }
+        } => cone_twist(f, swing1, swing2, twist, sink),
     }
 }
 
@@ -204,16 +204,6 @@ fn linear_axes(f: &Frames, axes: &[Axis; 3], h: Real, sink: &mut Sink) {
     }
 }
 
-/// [`linear_axes`] with the three axes locked (ball, hinge, cone-twist, fixed): the same
-/// three equality rows, written without the per-axis mode dispatch.
-#[inline]
-fn locked_point(f: &Frames, sink: &mut Sink) {
-    for i in 0..3 {
-        let axis = f.axis_a(i);
-        sink.linear(3 * i, axis, f, f.d.dot(axis), EQUALITY);
-    }
-}
-
 fn angular_axes(f: &Frames, axes: &[Axis; 3], h: Real, sink: &mut Sink) {
     let e = rotation_vector(f.q_rel);
     for (i, ax) in axes.iter().enumerate() {
@@ -262,7 +252,8 @@ pub(super) fn wrap_angle(a: Real) -> Real {
 
 /// Cone-twist: `q_rel = q_swing · q_twist` with the twist about X. The swing angle `φ` along
 /// the swing direction `u = (0, u_y, u_z)` is limited by the ellipse
-/// `1/φ_max² = (u_y/swing2)² + (u_z/swing1)²`; the twist angle by `±twist`. Limit rows are
+/// `1/φ_max² = (u_y/swing2)² + (u_z/swing1)²`; the twist angle by `±twist` (a zero `twist`
+/// is one equality row, slot 12). Limit rows are
 /// always present and act speculatively while inside the limits; at (nearly) zero swing the
 /// swing direction is undefined and the swing row is inactive.
 fn cone_twist(f: &Frames, swing1: Real, swing2: Real, twist: Real, sink: &mut Sink) {
@@ -288,15 +279,23 @@ fn cone_twist(f: &Frames, swing1: Real, swing2: Real, twist: Real, sink: &mut Si
         let axis = f.rotate_a(u);
         sink.angular(9, -axis, phi_max - phi, INEQUALITY);
     } else {
-        sink.put_inactive(9);
+        sink.put_inactive(9, RowKind::Inequality);
     }
     let tw = (f.axis_a(0) + Vec3A::from(f.rot_b * Vec3::X)).normalize_or_zero();
-    if tw != Vec3A::ZERO {
+    if twist == 0.0 {
+        // A zero span locks the twist: one equality row instead of two limits that meet
+        // (as a generic axis whose limits are equal).
+        if tw != Vec3A::ZERO {
+            sink.angular(12, tw, twist_angle, EQUALITY);
+        } else {
+            sink.put_inactive(12, RowKind::Equality);
+        }
+    } else if tw != Vec3A::ZERO {
         sink.angular(12, tw, twist_angle + twist, INEQUALITY);
         sink.angular(13, -tw, twist - twist_angle, INEQUALITY);
     } else {
-        sink.put_inactive(12);
-        sink.put_inactive(13);
+        sink.put_inactive(12, RowKind::Inequality);
+        sink.put_inactive(13, RowKind::Inequality);
     }
 }
 

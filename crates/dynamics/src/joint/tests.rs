@@ -63,6 +63,11 @@ fn kinds() -> Vec<JointKind> {
             swing2: 0.3,
             twist: 0.2,
         },
+        JointKind::ConeTwist {
+            swing1: 0.5,
+            swing2: 0.3,
+            twist: 0.0,
+        },
         JointKind::Slider {
             limits: Some((-0.5, 0.5)),
             motor,
@@ -135,6 +140,19 @@ fn moved(r: &mut Rig, turn_b: Quat) {
     r.set.rotation[ib] = (turn_b * r.set.rotation[ib]).normalize();
 }
 
+fn assert_same_point(fresh: &JointRows, refreshed: &JointRows, what: &str) {
+    match (&fresh.point, &refreshed.point) {
+        (None, None) => {}
+        (Some(x), Some(y)) => {
+            assert_eq!([x.ra, x.rb, x.c], [y.ra, y.rb, y.c], "{what}: point");
+            assert_eq!(x.axes, y.axes, "{what}: point axes");
+            assert_eq!((x.ma, x.mb), (y.ma, y.mb), "{what}: point I⁻¹ [r]×");
+            assert_eq!((x.inv_k, x.valid), (y.inv_k, y.valid), "{what}: point K⁻¹");
+        }
+        _ => panic!("{what}: a point block on one side only"),
+    }
+}
+
 fn assert_same_rows(fresh: &[Row], refreshed: &[Row], what: &str) {
     assert_eq!(fresh.len(), refreshed.len(), "{what}");
     for (x, y) in fresh.iter().zip(refreshed) {
@@ -163,21 +181,36 @@ fn refresh_equals_a_fresh_preparation_for_every_joint_type() {
             }
             let mut bodies = Vec::new();
             integrate::load(&r.set, &mut bodies);
-            let (jr, mut rows, mut blocks) = prepare(&r, &bodies);
+            let (mut jr, mut rows, mut blocks) = prepare(&r, &bodies);
             for row in rows.iter_mut() {
                 row.impulse = (row.impulse + 0.5).clamp(row.lo, row.hi);
             }
             let kept: Vec<Real> = rows.iter().map(|row| row.impulse).collect();
+            if let Some(p) = &mut jr.point {
+                // The stored slot impulses 0.01, 0.04, 0.07 along frame A's axes.
+                let slots = p.slot_impulses(p.impulse);
+                for (got, want) in slots.into_iter().zip([0.01, 0.04, 0.07]) {
+                    assert!((got - want * 0.25).abs() < 1e-6, "{what}: {slots:?}");
+                }
+                p.impulse += Vec3A::new(0.5, -0.25, 0.125);
+            }
+            let kept_point = jr.point.map(|p| p.impulse);
 
             moved(
                 &mut r,
                 Quat::from_axis_angle(Vec3::new(1.0, 2.0, -0.5).normalize(), 0.25),
             );
             let (_, j) = r.joints.iter().next().unwrap();
-            refresh_joint(&jr, j, &r.set, &bodies, &mut rows, &mut blocks);
-            let (_, fresh, fresh_blocks) = prepare(&r, &bodies);
+            refresh_joint(&mut jr, j, &r.set, &bodies, &mut rows, &mut blocks);
+            let (fresh_jr, fresh, fresh_blocks) = prepare(&r, &bodies);
 
             assert_same_rows(&fresh, &rows, &what);
+            assert_same_point(&fresh_jr, &jr, &what);
+            assert_eq!(
+                kept_point,
+                jr.point.map(|p| p.impulse),
+                "{what}: point impulse"
+            );
             let kept_now: Vec<Real> = rows.iter().map(|row| row.impulse).collect();
             assert_eq!(kept, kept_now, "{what}: impulses are kept");
             assert_eq!(fresh_blocks.len(), blocks.len(), "{what}");
@@ -198,14 +231,20 @@ fn refresh_equals_a_fresh_preparation_for_every_joint_type() {
 
 #[test]
 fn row_counts_follow_the_joint_description() {
-    let counts = [3, 6, 5, 8, 6, 8, 10];
-    for (kind, n) in kinds().into_iter().zip(counts) {
+    // Rows besides the point block (ball, fixed, hinges, cone-twist have one).
+    let counts = [0, 3, 2, 5, 3, 2, 8, 10];
+    let points = [true, true, true, true, true, true, false, false];
+    for ((kind, n), point) in kinds().into_iter().zip(counts).zip(points) {
         let r = rig(kind, Vec3::ZERO);
         let mut bodies = Vec::new();
         integrate::load(&r.set, &mut bodies);
         let (jr, rows, blocks) = prepare(&r, &bodies);
         assert_eq!(rows.len(), n, "{kind:?}");
         assert_eq!(jr.rows, 0..n, "{kind:?}");
+        assert_eq!(jr.point.is_some(), point, "{kind:?}");
+        if let Some(p) = jr.point {
+            assert!(p.valid && p.c.length() < 1e-4, "{kind:?}: c = {}", p.c);
+        }
         // Satisfied at the start: every equality row has zero error, every block is valid.
         assert!(blocks.iter().all(|b| b.valid), "{kind:?}");
         for row in &rows {
@@ -232,7 +271,7 @@ fn cone_rows_are_inactive_where_their_axes_are_undefined() {
     let mut bodies = Vec::new();
     integrate::load(&r.set, &mut bodies);
     // No swing at the start: the swing row (slot 9) has no axis.
-    let (jr, mut rows, mut blocks) = prepare(&r, &bodies);
+    let (mut jr, mut rows, mut blocks) = prepare(&r, &bodies);
     let swing = rows.iter().position(|row| row.slot == 9).unwrap();
     assert_eq!(rows[swing].ang_b, Vec3A::ZERO);
     assert_eq!((rows[swing].inv_k, rows[swing].impulse), (0.0, 0.0));
@@ -244,7 +283,7 @@ fn cone_rows_are_inactive_where_their_axes_are_undefined() {
     let y = fa.rotation * Vec3::Y;
     moved(&mut r, Quat::from_axis_angle(y, 0.2));
     let (_, j) = r.joints.iter().next().unwrap();
-    refresh_joint(&jr, j, &r.set, &bodies, &mut rows, &mut blocks);
+    refresh_joint(&mut jr, j, &r.set, &bodies, &mut rows, &mut blocks);
     assert!(rows[swing].ang_b.length() > 0.5 && rows[swing].inv_k > 0.0);
     // Back to no swing (B's frame turned onto A's, plus a twist about their common X):
     // the swing row is inactive again and its impulse is dropped.
@@ -256,7 +295,7 @@ fn cone_rows_are_inactive_where_their_axes_are_undefined() {
         (r.set.rotation[ia] * desc.frame_a.rotation * twist * desc.frame_b.rotation.conjugate())
             .normalize();
     let (_, j) = r.joints.iter().next().unwrap();
-    refresh_joint(&jr, j, &r.set, &bodies, &mut rows, &mut blocks);
+    refresh_joint(&mut jr, j, &r.set, &bodies, &mut rows, &mut blocks);
     assert_eq!(rows[swing].ang_b, Vec3A::ZERO);
     assert_eq!((rows[swing].inv_k, rows[swing].impulse), (0.0, 0.0));
     let (_, fresh, _) = prepare(&r, &bodies);
@@ -283,10 +322,10 @@ fn a_singular_block_falls_back_to_rows_and_stays_finite() {
     }
     moved(&mut r, Quat::from_rotation_z(0.3));
     let (jr, rows, blocks) = prepare(&r, &bodies);
-    assert_eq!(blocks.len(), 2);
-    assert!(blocks[0].valid, "the point block has the masses");
-    assert!(!blocks[1].valid, "the rotation block is singular");
-    assert!(rows[3..].iter().all(|row| row.inv_k == 0.0));
+    assert_eq!(blocks.len(), 1);
+    assert!(jr.point.unwrap().valid, "the point block has the masses");
+    assert!(!blocks[0].valid, "the rotation block is singular");
+    assert!(rows.iter().all(|row| row.inv_k == 0.0));
     let mut s = JointScratch::default();
     s.joints.push(jr);
     s.rows = rows;
@@ -301,7 +340,7 @@ fn a_singular_block_falls_back_to_rows_and_stays_finite() {
         assert!(b.v.is_finite() && b.w.is_finite());
         assert_eq!(b.w, w, "no angular change without inverse inertia");
     }
-    // The point rows did act.
-    assert!(s.rows[..3].iter().all(|row| row.impulse.is_finite()));
-    assert!(s.rows[..3].iter().any(|row| row.impulse != 0.0));
+    // The point block did act.
+    let impulse = s.joints[0].point.unwrap().impulse;
+    assert!(impulse.is_finite() && impulse != Vec3A::ZERO);
 }

@@ -6,8 +6,9 @@
 //! Both solve the joints before the contacts of each iteration (Bullet solves non-contact
 //! constraints first as well). The colouring depends only on the joint set and
 //! which bodies move, so the order — and every bit of the result — is the same for any
-//! thread count. Runs of equality rows (a ball joint's point, a fixed joint's rotation) are
-//! solved as coupled blocks ([`Block`]).
+//! thread count. The point of a ball, hinge, cone-twist or fixed joint is one world-frame
+//! 3×3 block ([`PointBlock`], solved first); runs of the other equality rows (a hinge's
+//! alignment, a fixed joint's rotation) are solved as coupled blocks ([`Block`]).
 //!
 //! The rows live in the world-owned [`JointScratch`]: [`prepare`] fills it once per step
 //! in colour order (no allocation once the buffers have grown to the joint count), and the
@@ -15,7 +16,7 @@
 //! `b3PrepareJoint` from the substep solves; module `joint::build`).
 
 use super::coloring::{colour_into, ColourScratch, Colouring};
-use super::rows::{Block, Motion, Row};
+use super::rows::{Block, Motion, PointBlock, Row};
 use super::{Softness, SolverBody};
 use crate::body_set::BodySet;
 use crate::joint::{masses_own, prepare_joint, refresh_own, JointRows, JointSet, ROW_SLOTS};
@@ -119,9 +120,18 @@ impl JointScratch {
     }
 }
 
-/// Applies the accumulated impulses of one joint (`rows`: its own rows).
+/// Applies the accumulated impulses of one joint (`point`: its point block, `rows`: its own
+/// rows).
 #[inline]
-pub(crate) fn warm_start_joint(rows: &[Row], a: &mut Motion, b: &mut Motion) {
+pub(crate) fn warm_start_joint(
+    point: Option<&PointBlock>,
+    rows: &[Row],
+    a: &mut Motion,
+    b: &mut Motion,
+) {
+    if let Some(p) = point {
+        p.warm_start(a, b);
+    }
     for row in rows {
         row.warm_start(a, b);
     }
@@ -132,7 +142,7 @@ pub(crate) fn warm_start(s: &mut JointScratch, bodies: &mut [SolverBody]) {
     for &k in &s.by_slot {
         let jr = &s.joints[k];
         let (mut a, mut b) = (Motion::of(&bodies[jr.a]), Motion::of(&bodies[jr.b]));
-        warm_start_joint(&s.rows[jr.rows.clone()], &mut a, &mut b);
+        warm_start_joint(jr.point.as_ref(), &s.rows[jr.rows.clone()], &mut a, &mut b);
         write_back(bodies, jr, a, b);
     }
 }
@@ -142,11 +152,13 @@ fn write_back(bodies: &mut [SolverBody], jr: &JointRows, a: Motion, b: Motion) {
     b.store(&mut bodies[jr.b]);
 }
 
-/// One pass over the rows of one joint (`rows`, `blocks`: its own): valid blocks of
-/// equality rows together, the other rows one by one, in row order. Each row's error is the
-/// one of its last build or refresh.
+/// One pass over one joint (`point`, `rows`, `blocks`: its own): the point block first,
+/// then valid blocks of equality rows together, the other rows one by one, in row order.
+/// Each error is the one of the last build or refresh.
 #[inline]
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn solve_joint(
+    point: Option<&mut PointBlock>,
     rows: &mut [Row],
     blocks: &[Block],
     a: &mut Motion,
@@ -155,6 +167,9 @@ pub(crate) fn solve_joint(
     inv_h: Real,
     use_bias: bool,
 ) {
+    if let Some(p) = point {
+        p.solve(a, b, soft, use_bias);
+    }
     let mut i = 0;
     for block in blocks {
         for row in &mut rows[i..block.start] {
@@ -189,11 +204,12 @@ pub(crate) fn solve(
     use_bias: bool,
 ) {
     for &k in &s.by_slot {
-        let jr = &s.joints[k];
+        let jr = &mut s.joints[k];
         let (mut a, mut b) = (Motion::of(&bodies[jr.a]), Motion::of(&bodies[jr.b]));
         let rows = &mut s.rows[jr.rows.clone()];
         let blocks = &s.blocks[jr.blocks.clone()];
-        solve_joint(rows, blocks, &mut a, &mut b, soft, inv_h, use_bias);
+        let point = jr.point.as_mut();
+        solve_joint(point, rows, blocks, &mut a, &mut b, soft, inv_h, use_bias);
         write_back(bodies, jr, a, b);
     }
 }
@@ -214,7 +230,7 @@ pub(crate) enum JointPass {
 /// and blocks and their dynamic bodies.
 #[derive(Clone, Copy)]
 pub(crate) struct JointView {
-    joints: *const JointRows,
+    joints: *mut JointRows,
     n_joints: usize,
     rows: *mut Row,
     n_rows: usize,
@@ -228,7 +244,7 @@ impl JointView {
     /// Views of `s`'s buffers (valid while `s` is neither moved nor resized).
     pub fn new(s: &mut JointScratch) -> JointView {
         JointView {
-            joints: s.joints.as_ptr(),
+            joints: s.joints.as_mut_ptr(),
             n_joints: s.joints.len(),
             rows: s.rows.as_mut_ptr(),
             n_rows: s.rows.len(),
@@ -266,7 +282,7 @@ impl JointView {
     ) {
         assert!(range.end <= self.n_joints);
         for i in range {
-            let jr = &*self.joints.add(i);
+            let jr = &mut *self.joints.add(i);
             let (rows, blocks) = (jr.rows.clone(), jr.blocks.clone());
             assert!(rows.start <= rows.end && rows.end <= self.n_rows);
             assert!(blocks.start <= blocks.end && blocks.end <= self.n_blocks);
@@ -276,20 +292,22 @@ impl JointView {
                 std::slice::from_raw_parts_mut(self.blocks.add(blocks.start), blocks.len());
             let (pa, pb) = (bodies.add(jr.a), bodies.add(jr.b));
             if first {
-                masses_own(own, own_blocks, &*pa, &*pb);
+                masses_own(jr.point.as_mut(), own, own_blocks, &*pa, &*pb);
             }
             let (mut a, mut b) = (Motion::of(&*pa), Motion::of(&*pb));
             match pass {
-                JointPass::WarmStart => warm_start_joint(own, &mut a, &mut b),
+                JointPass::WarmStart => warm_start_joint(jr.point.as_ref(), own, &mut a, &mut b),
                 JointPass::Solve => {
-                    solve_joint(own, own_blocks, &mut a, &mut b, soft, inv_h, true);
+                    let point = jr.point.as_mut();
+                    solve_joint(point, own, own_blocks, &mut a, &mut b, soft, inv_h, true);
                 }
                 JointPass::Relax => {
                     // Rows follow the new poses (valid until the next position update).
                     if let Some(j) = joints.get_index(jr.joint) {
                         refresh_own(jr, j, set, &*pa, &*pb, own, own_blocks);
                     }
-                    solve_joint(own, own_blocks, &mut a, &mut b, soft, inv_h, false);
+                    let point = jr.point.as_mut();
+                    solve_joint(point, own, own_blocks, &mut a, &mut b, soft, inv_h, false);
                     // The relax is the substep's last joint pass: its impulses are the
                     // substep's (summed only where breaking reads them).
                     if jr.breakable {
@@ -297,6 +315,9 @@ impl JointView {
                             std::slice::from_raw_parts_mut(self.sums.add(rows.start), rows.len());
                         for (sum, row) in sums.iter_mut().zip(own.iter()) {
                             *sum += row.impulse;
+                        }
+                        if let Some(p) = &mut jr.point {
+                            p.sum += p.impulse;
                         }
                     }
                 }
@@ -323,6 +344,20 @@ pub(crate) fn store(s: &JointScratch, joints: &mut JointSet, scale: Real, summed
         if let Some(j) = joints.get_index_mut(jr.joint) {
             j.impulses = [0.0; ROW_SLOTS];
             let mut peak: Real = 0.0;
+            if let Some(p) = &jr.point {
+                // Components along frame A's axes (the three rows' slots before the
+                // point became one block), at the last refresh's axes.
+                let stored = p.slot_impulses(p.impulse * scale);
+                let step = if summed && jr.breakable {
+                    p.slot_impulses(p.sum)
+                } else {
+                    stored
+                };
+                for i in 0..3 {
+                    j.impulses[3 * i] = stored[i];
+                    peak = peak.max(step[i].abs());
+                }
+            }
             for (k, row) in s.rows[jr.rows.clone()].iter().enumerate() {
                 let stored = row.impulse * scale;
                 j.impulses[row.slot as usize] = stored;
