@@ -18,7 +18,7 @@
 //! talk ("instead of EPA, sample penetration depth using support mapping").
 
 use super::gjk::Simplex;
-use super::simplex::closest_to_origin;
+use super::simplex::{closest_to_origin, Barycentric};
 use super::support_adapters::{MinkowskiDiff, Support};
 use crate::math::{Real, Vec3, EPSILON};
 
@@ -109,7 +109,14 @@ fn make_face(verts: &[Vertex], idx: [u32; 3], tol: Real) -> Option<Face> {
     );
     let n = (q - p).cross(r - p);
     let len = n.length();
-    let edge = (q - p).length().max((r - p).length()).max((r - q).length());
+    // One square root of the largest squared edge length: `sqrt` is correctly rounded and
+    // monotone, so `sqrt(max(a, b, c)) == max(sqrt a, sqrt b, sqrt c)` bit for bit (and
+    // `max` skips a NaN the same way on either side), two square roots fewer per face.
+    let edge = (q - p)
+        .length_squared()
+        .max((r - p).length_squared())
+        .max((r - q).length_squared())
+        .sqrt();
     if len.is_nan() || len <= tol * edge {
         return None;
     }
@@ -261,10 +268,10 @@ fn edge_index(f: &Face, i: u32, j: u32) -> Option<usize> {
     (0..3).find(|&e| f.idx[e] == i && f.idx[(e + 1) % 3] == j)
 }
 
-fn result_from_face(verts: &[Vertex], f: &Face) -> Penetration {
+/// The penetration of face `f`, with `sol` the closest point to the origin of its triangle
+/// (`closest_to_origin` of its three `w`, in index order).
+fn result_from_face(verts: &[Vertex], f: &Face, sol: &Barycentric) -> Penetration {
     let v = |k: usize| verts[f.idx[k] as usize];
-    let tri = [v(0).w, v(1).w, v(2).w];
-    let sol = closest_to_origin(&tri);
     let mut pa = Vec3::ZERO;
     let mut pb = Vec3::ZERO;
     for k in 0..3 {
@@ -374,23 +381,32 @@ fn expand<A: Support, B: Support>(
     let (verts, faces) = (&scratch.verts, &scratch.faces);
     let best = faces[best_i as usize];
     let slack = EPA_REL_TOL * scale.max(EPSILON) * 4.0;
+    let tri_of = |f: &Face| {
+        [
+            verts[f.idx[0] as usize].w,
+            verts[f.idx[1] as usize].w,
+            verts[f.idx[2] as usize].w,
+        ]
+    };
     let mut pick = best;
+    let mut pick_sol = None;
     let mut pick_d = Real::INFINITY;
     for f in faces.iter().filter(|f| {
         !f.removed && f.dist <= best.dist + slack && f.normal.dot(best.normal) >= COPLANAR_COS
     }) {
-        let tri = [
-            verts[f.idx[0] as usize].w,
-            verts[f.idx[1] as usize].w,
-            verts[f.idx[2] as usize].w,
-        ];
-        let d = closest_to_origin(&tri).point(&tri).length_squared();
+        let tri = tri_of(f);
+        let sol = closest_to_origin(&tri);
+        let d = sol.point(&tri).length_squared();
         if d < pick_d {
             pick_d = d;
             pick = *f;
+            pick_sol = Some(sol);
         }
     }
-    result_from_face(verts, &pick)
+    // The winner's barycentric solution is reused for its witnesses (the same call on the
+    // same triangle); it is recomputed only when no face won (NaN distances).
+    let sol = pick_sol.unwrap_or_else(|| closest_to_origin(&tri_of(&pick)));
+    result_from_face(verts, &pick, &sol)
 }
 
 /// The live face closest to the origin (first on ties, so the result is deterministic).
@@ -526,6 +542,53 @@ mod tests {
             assert!((p.depth - depth).abs() < 1e-4, "{p:?}");
             assert!((p.normal - n).length() < 1e-4, "{p:?}");
             assert!((p.point_a - p.point_b - p.normal * p.depth).length() < 1e-4);
+        }
+    }
+
+    /// `make_face`'s one square root of the largest squared edge equals the largest of the
+    /// three edge lengths bit for bit (the old code), on random, degenerate (zero-size,
+    /// collinear, repeated), huge, tiny, far-from-origin and non-finite triangles.
+    #[test]
+    fn one_square_root_edge_matches_three() {
+        let old = |p: Vec3, q: Vec3, r: Vec3| {
+            (q - p).length().max((r - p).length()).max((r - q).length())
+        };
+        let new = |p: Vec3, q: Vec3, r: Vec3| {
+            (q - p)
+                .length_squared()
+                .max((r - p).length_squared())
+                .max((r - q).length_squared())
+                .sqrt()
+        };
+        let mut seed = 0x9E37_79B9_7F4A_7C15_u64;
+        let mut rnd = || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as Real / (1u64 << 53) as Real * 2.0 - 1.0
+        };
+        let mut tris = Vec::new();
+        for k in 0..20_000 {
+            let scale = [1.0e-20, 1.0e-3, 1.0, 1.0e3, 1.0e15][k % 5];
+            let far = Vec3::splat([0.0, 1.0e4, -3.0e6][k % 3]);
+            let mut v = || Vec3::new(rnd(), rnd(), rnd()) * scale + far;
+            let (p, q, r) = (v(), v(), v());
+            tris.push((p, q, r));
+            tris.push((p, p, r)); // repeated vertex
+            tris.push((p, q, p + (q - p) * 0.5)); // collinear
+            tris.push((p, q, q + (q - p) * 1.0e-3)); // nearly collinear, two equal edges
+        }
+        let x = Vec3::new(1.0, 2.0, 3.0);
+        tris.push((x, x, x)); // zero size
+        tris.push((x, Vec3::splat(Real::NAN), Vec3::ZERO));
+        tris.push((x, Vec3::splat(Real::INFINITY), Vec3::ZERO));
+        tris.push((Vec3::splat(Real::MAX), -Vec3::splat(Real::MAX), Vec3::ZERO));
+        for (p, q, r) in tris {
+            let (a, b) = (old(p, q, r), new(p, q, r));
+            assert!(
+                a.to_bits() == b.to_bits() || (a.is_nan() && b.is_nan()),
+                "{p} {q} {r}: {a} vs {b}"
+            );
         }
     }
 
