@@ -22,6 +22,7 @@ mod static_bvh;
 mod traverse;
 mod tree_insert;
 mod tree_query;
+mod tree_split;
 mod tree_validate;
 mod tree_wide;
 mod wide;

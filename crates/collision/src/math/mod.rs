@@ -48,6 +48,9 @@ mod types {
 
 pub use types::*;
 
+/// glam's swizzle methods (`v.yzx()`…) on [`Vec3`] and [`Vec3A`] (one trait in both builds).
+pub use glam::Vec3Swizzles;
+
 /// Machine epsilon of [`Real`].
 pub const EPSILON: Real = Real::EPSILON;
 

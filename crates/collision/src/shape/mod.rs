@@ -268,19 +268,23 @@ impl Shape {
 
     /// Tight world bounding box of the shape placed at `pose`. Exact for convex shapes (six
     /// support queries along the world axes); for meshes and compounds, the children's boxes.
+    #[inline]
     pub fn aabb(&self, pose: &Isometry) -> Aabb {
+        // Spheres and boxes inline at the call site (the per-body sync of a pile of boxes:
+        // no call into the large frame of the other arms); the rest stays out of line.
         match self {
-            Shape::Sphere(s) => {
-                Aabb::from_center_half_extents(pose.translation, Vec3::splat(s.radius()))
-            }
-            Shape::Cuboid(s) => {
-                // Arvo's box of a centred box: the half extents through |R| (the centre is the
-                // translation, so no rotation of the local centre).
-                let m = crate::math::Mat3::from_quat(pose.rotation);
-                let h = s.half_extents();
-                let e = m.x_axis.abs() * h.x + m.y_axis.abs() * h.y + m.z_axis.abs() * h.z;
-                Aabb::new(pose.translation - e, pose.translation + e)
-            }
+            Shape::Sphere(s) => sphere_aabb(s, pose),
+            Shape::Cuboid(s) => cuboid_aabb(s, pose),
+            _ => self.aabb_out_of_line(pose),
+        }
+    }
+
+    /// [`Shape::aabb`] of the shapes it does not inline.
+    #[inline(never)]
+    fn aabb_out_of_line(&self, pose: &Isometry) -> Aabb {
+        match self {
+            Shape::Sphere(s) => sphere_aabb(s, pose),
+            Shape::Cuboid(s) => cuboid_aabb(s, pose),
             Shape::Cylinder(c) => {
                 let (lo, hi) = axial_extents(pose, c.radius(), c.half_height(), false);
                 Aabb::new(pose.translation + lo, pose.translation + hi)
@@ -412,6 +416,20 @@ macro_rules! impl_from {
 impl_from!(Sphere => Sphere, Cuboid => Cuboid, Capsule => Capsule, Cylinder => Cylinder,
     Cone => Cone, ConvexHull => ConvexHull, Triangle => Triangle, Plane => Plane,
     TriMesh => TriMesh, Compound => Compound, Scaled => Scaled, HeightField => HeightField);
+
+/// The world box of a sphere at `pose`.
+#[inline]
+fn sphere_aabb(s: &Sphere, pose: &Isometry) -> Aabb {
+    Aabb::from_center_half_extents(pose.translation, Vec3::splat(s.radius()))
+}
+
+/// The world box of a box at `pose`: Arvo's box of a centred box, the half extents through
+/// |R| (the centre is the translation, so no rotation of the local centre).
+#[inline]
+fn cuboid_aabb(s: &Cuboid, pose: &Isometry) -> Aabb {
+    let e = cuboid::rotated_half_extents(pose.rotation, s.half_extents());
+    Aabb::new(pose.translation - e, pose.translation + e)
+}
 
 /// World-axis extents (offsets of the box's min and max corners from the centre) of a
 /// cylinder or cone of base `radius` along its local y axis from `-half_height` to
