@@ -85,8 +85,15 @@ const SPREAD: [u32; 16] = {
 /// and their signs (bit `k` set when dot `k` is positive, bit `k + 3` when negative), and
 /// per triangle edge the hull edges whose arcs cross its great circle, in hull-edge order.
 /// Larger hulls take the scalar passes (`dots_aos`, `crossing`).
+///
+/// The placed vertices are kept as blocks of four lanes too (`verts`, the last block padded
+/// with copies of the first vertex, which change no minimum or maximum), for the triangle's
+/// two faces: the dots with the triangle's normal four vertices at a time, in `Vec3::dot`'s
+/// order, and the same strict comparisons as a scalar scan, so the minimum and maximum are
+/// the scalar ones (up to the sign of an exact zero; NaN dots are skipped alike).
 pub(crate) struct EdgeScratch {
     blocks: SmallVec<[FaceBlock; 16]>,
+    verts: SmallVec<[[W; 3]; 16]>,
     dots: [[Real; LANE_FACES]; 3],
     odots: [[Real; LANE_FACES]; 3],
     signs: [u8; LANE_FACES],
@@ -108,6 +115,7 @@ impl EdgeScratch {
     fn empty() -> EdgeScratch {
         EdgeScratch {
             blocks: SmallVec::new(),
+            verts: SmallVec::new(),
             dots: [[0.0; LANE_FACES]; 3],
             odots: [[0.0; LANE_FACES]; 3],
             signs: [0; LANE_FACES],
@@ -121,6 +129,17 @@ impl EdgeScratch {
     /// at most [`LANE_FACES`] faces and [`LANE_EDGES`] edges.
     fn set_hull(&mut self, b: &Polyhedron, posed: &PosedPolyhedron) {
         let (nb, ob) = (&posed.normals[..], &posed.offsets[..]);
+        self.verts.clear();
+        if let Some(&first) = posed.vertices.first() {
+            for v in posed.vertices.chunks(4) {
+                let ls = [0, 1, 2, 3].map(|l| v.get(l).copied().unwrap_or(first));
+                self.verts.push([
+                    W::new(ls.map(|v| v.x)),
+                    W::new(ls.map(|v| v.y)),
+                    W::new(ls.map(|v| v.z)),
+                ]);
+            }
+        }
         self.blocks.clear();
         if nb.len() <= LANE_FACES && b.edge_faces().len() <= LANE_EDGES {
             for (n, off) in nb.chunks(4).zip(ob.chunks(4)) {
@@ -219,16 +238,11 @@ pub(crate) fn triangle_hull_manifold(
     // separations `min(n · v) - off` and `off - max(n · v)`, exactly those of the general
     // face query (negation is exact).
     let front = a.faces()[0];
-    let (mut lo, mut hi) = (Real::INFINITY, Real::NEG_INFINITY);
-    for v in vb {
-        let d = front.normal.dot(*v);
-        if d < lo {
-            lo = d;
-        }
-        if d > hi {
-            hi = d;
-        }
-    }
+    let (lo, hi) = if scratch.verts.is_empty() {
+        normal_range(vb, front.normal)
+    } else {
+        normal_range_lanes(&scratch.verts, front.normal)
+    };
     let (s0, s1) = (lo - front.offset, -hi - a.faces()[1].offset);
     let (sa, fa) = if s1 > s0 { (s1, 1) } else { (s0, 0) };
     if sa > prediction {
@@ -291,6 +305,47 @@ pub(crate) fn triangle_hull_manifold(
         edge,
         out,
     );
+}
+
+/// The minimum and maximum of `n · v` over the vertices `vb` (infinite when empty; NaN dots
+/// are skipped).
+fn normal_range(vb: &[Vec3], n: Vec3) -> (Real, Real) {
+    let (mut lo, mut hi) = (Real::INFINITY, Real::NEG_INFINITY);
+    for v in vb {
+        let d = n.dot(*v);
+        if d < lo {
+            lo = d;
+        }
+        if d > hi {
+            hi = d;
+        }
+    }
+    (lo, hi)
+}
+
+/// [`normal_range`] over vertex blocks of four lanes ([`EdgeScratch`]'s `verts`): the same
+/// products and sums per vertex and the same strict comparisons, per lane and then across
+/// the lanes, so the same values (a minimum or maximum does not depend on the order in
+/// which it is found, except for the sign of an exact zero).
+fn normal_range_lanes(verts: &[[W; 3]], n: Vec3) -> (Real, Real) {
+    let (nx, ny, nz) = (W::splat(n.x), W::splat(n.y), W::splat(n.z));
+    let (mut lo, mut hi) = (W::splat(Real::INFINITY), W::splat(Real::NEG_INFINITY));
+    for [x, y, z] in verts {
+        let d = *x * nx + *y * ny + *z * nz;
+        lo = d.simd_lt(lo).bitselect(d, lo);
+        hi = d.simd_gt(hi).bitselect(d, hi);
+    }
+    let (lo, hi) = (lo.to_array(), hi.to_array());
+    let (mut l, mut h) = (lo[0], hi[0]);
+    for k in 1..4 {
+        if lo[k] < l {
+            l = lo[k];
+        }
+        if hi[k] > h {
+            h = hi[k];
+        }
+    }
+    (l, h)
 }
 
 /// The edge query of the general path for a flat triangle A and a solid B, with the
