@@ -47,6 +47,17 @@ const LANE_FACES: usize = 64;
 /// ... and at most this many edges (a closed polyhedron with 64 faces has at most 186).
 const LANE_EDGES: usize = 192;
 
+/// Face indices of a lane hull are below [`LANE_FACES`], a power of two: the edge query
+/// masks them with `FACE_MASK` (a no-op on them) so the compiler drops the bounds checks
+/// of the per-face rows.
+const FACE_MASK: usize = LANE_FACES - 1;
+/// The crossing lists are [`LIST_LEN`] long, a power of two above [`LANE_EDGES`]: their
+/// lengths (at most the hull's edge count) are masked with `LIST_LEN - 1` (a no-op) so the
+/// compiler drops the bounds checks of the appends.
+const LIST_LEN: usize = 256;
+const _: () = assert!(LANE_FACES.is_power_of_two() && LIST_LEN.is_power_of_two());
+const _: () = assert!(LIST_LEN > LANE_EDGES && LANE_EDGES <= 1 + u8::MAX as usize);
+
 /// Four face planes of the placed hull, one per lane (normal `x`, `y`, `z`, offset). The
 /// last block is padded with zero normals and an infinite offset: a padding face separates
 /// by `-inf` (never the best) and has no sign.
@@ -97,7 +108,7 @@ pub(crate) struct EdgeScratch {
     dots: [[Real; LANE_FACES]; 3],
     odots: [[Real; LANE_FACES]; 3],
     signs: [u8; LANE_FACES],
-    lists: [[u8; LANE_EDGES]; 3],
+    lists: [[u8; LIST_LEN]; 3],
     dots_aos: SmallVec<[[Real; 3]; 64]>,
     crossing: SmallVec<[(u32, u8); 64]>,
 }
@@ -119,7 +130,7 @@ impl EdgeScratch {
             dots: [[0.0; LANE_FACES]; 3],
             odots: [[0.0; LANE_FACES]; 3],
             signs: [0; LANE_FACES],
-            lists: [[0; LANE_EDGES]; 3],
+            lists: [[0; LIST_LEN]; 3],
             dots_aos: SmallVec::new(),
             crossing: SmallVec::new(),
         }
@@ -142,6 +153,11 @@ impl EdgeScratch {
         }
         self.blocks.clear();
         if nb.len() <= LANE_FACES && b.edge_faces().len() <= LANE_EDGES {
+            debug_assert!(b
+                .edge_faces()
+                .iter()
+                .flatten()
+                .all(|&f| (f as usize) < nb.len()));
             for (n, off) in nb.chunks(4).zip(ob.chunks(4)) {
                 let lane = |l: usize| n.get(l).copied().unwrap_or(Vec3::ZERO);
                 let off = |l: usize| off.get(l).copied().unwrap_or(Real::INFINITY);
@@ -431,13 +447,13 @@ fn triangle_hull_edge_query(
         // both negative, i.e. when bit `k` or bit `k + 3` survives the AND of their signs.
         let mut counts = [0usize; 3];
         for (j, fb) in faces_b.iter().enumerate() {
-            let both = signs[fb[0] as usize] & signs[fb[1] as usize];
+            let both = signs[fb[0] as usize & FACE_MASK] & signs[fb[1] as usize & FACE_MASK];
             let bits = !(both | (both >> 3)) & 0b111;
             if bits == 0 {
                 continue;
             }
             for (k, list) in lists.iter_mut().enumerate() {
-                list[counts[k]] = j as u8;
+                list[counts[k] & (LIST_LEN - 1)] = j as u8;
                 counts[k] += usize::from((bits >> k) & 1 != 0);
             }
         }
@@ -448,7 +464,7 @@ fn triangle_hull_edge_query(
             for &j in &lists[i][..counts[i]] {
                 let j = j as usize;
                 let fb = faces_b[j];
-                let (f0, f1) = (fb[0] as usize, fb[1] as usize);
+                let (f0, f1) = (fb[0] as usize & FACE_MASK, fb[1] as usize & FACE_MASK);
                 let (a0, a1) = (row[f0], row[f1]);
                 // The prefilter with `m · o = a0 (n1 · o) - a1 (n0 · o)` from the faces'
                 // dots with `o`, and `|m|² <= (|a0| + |a1|)²` (unit normals): it drops no
