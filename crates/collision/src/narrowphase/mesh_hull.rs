@@ -47,6 +47,17 @@ const LANE_FACES: usize = 64;
 /// ... and at most this many edges (a closed polyhedron with 64 faces has at most 186).
 const LANE_EDGES: usize = 192;
 
+/// Face indices of a lane hull are below [`LANE_FACES`], a power of two: the edge query
+/// masks them with `FACE_MASK` (a no-op on them) so the compiler drops the bounds checks
+/// of the per-face rows.
+const FACE_MASK: usize = LANE_FACES - 1;
+/// The crossing lists are [`LIST_LEN`] long, a power of two above [`LANE_EDGES`]: their
+/// lengths (at most the hull's edge count) are masked with `LIST_LEN - 1` (a no-op) so the
+/// compiler drops the bounds checks of the appends.
+const LIST_LEN: usize = 256;
+const _: () = assert!(LANE_FACES.is_power_of_two() && LIST_LEN.is_power_of_two());
+const _: () = assert!(LIST_LEN > LANE_EDGES && LANE_EDGES <= 1 + u8::MAX as usize);
+
 /// Four face planes of the placed hull, one per lane (normal `x`, `y`, `z`, offset). The
 /// last block is padded with zero normals and an infinite offset: a padding face separates
 /// by `-inf` (never the best) and has no sign.
@@ -85,12 +96,19 @@ const SPREAD: [u32; 16] = {
 /// and their signs (bit `k` set when dot `k` is positive, bit `k + 3` when negative), and
 /// per triangle edge the hull edges whose arcs cross its great circle, in hull-edge order.
 /// Larger hulls take the scalar passes (`dots_aos`, `crossing`).
+///
+/// The placed vertices are kept as blocks of four lanes too (`verts`, the last block padded
+/// with copies of the first vertex, which change no minimum or maximum), for the triangle's
+/// two faces: the dots with the triangle's normal four vertices at a time, in `Vec3::dot`'s
+/// order, and the same strict comparisons as a scalar scan, so the minimum and maximum are
+/// the scalar ones (up to the sign of an exact zero; NaN dots are skipped alike).
 pub(crate) struct EdgeScratch {
     blocks: SmallVec<[FaceBlock; 16]>,
+    verts: SmallVec<[[W; 3]; 16]>,
     dots: [[Real; LANE_FACES]; 3],
     odots: [[Real; LANE_FACES]; 3],
     signs: [u8; LANE_FACES],
-    lists: [[u8; LANE_EDGES]; 3],
+    lists: [[u8; LIST_LEN]; 3],
     dots_aos: SmallVec<[[Real; 3]; 64]>,
     crossing: SmallVec<[(u32, u8); 64]>,
 }
@@ -108,10 +126,11 @@ impl EdgeScratch {
     fn empty() -> EdgeScratch {
         EdgeScratch {
             blocks: SmallVec::new(),
+            verts: SmallVec::new(),
             dots: [[0.0; LANE_FACES]; 3],
             odots: [[0.0; LANE_FACES]; 3],
             signs: [0; LANE_FACES],
-            lists: [[0; LANE_EDGES]; 3],
+            lists: [[0; LIST_LEN]; 3],
             dots_aos: SmallVec::new(),
             crossing: SmallVec::new(),
         }
@@ -121,8 +140,24 @@ impl EdgeScratch {
     /// at most [`LANE_FACES`] faces and [`LANE_EDGES`] edges.
     fn set_hull(&mut self, b: &Polyhedron, posed: &PosedPolyhedron) {
         let (nb, ob) = (&posed.normals[..], &posed.offsets[..]);
+        self.verts.clear();
+        if let Some(&first) = posed.vertices.first() {
+            for v in posed.vertices.chunks(4) {
+                let ls = [0, 1, 2, 3].map(|l| v.get(l).copied().unwrap_or(first));
+                self.verts.push([
+                    W::new(ls.map(|v| v.x)),
+                    W::new(ls.map(|v| v.y)),
+                    W::new(ls.map(|v| v.z)),
+                ]);
+            }
+        }
         self.blocks.clear();
         if nb.len() <= LANE_FACES && b.edge_faces().len() <= LANE_EDGES {
+            debug_assert!(b
+                .edge_faces()
+                .iter()
+                .flatten()
+                .all(|&f| (f as usize) < nb.len()));
             for (n, off) in nb.chunks(4).zip(ob.chunks(4)) {
                 let lane = |l: usize| n.get(l).copied().unwrap_or(Vec3::ZERO);
                 let off = |l: usize| off.get(l).copied().unwrap_or(Real::INFINITY);
@@ -219,16 +254,11 @@ pub(crate) fn triangle_hull_manifold(
     // separations `min(n · v) - off` and `off - max(n · v)`, exactly those of the general
     // face query (negation is exact).
     let front = a.faces()[0];
-    let (mut lo, mut hi) = (Real::INFINITY, Real::NEG_INFINITY);
-    for v in vb {
-        let d = front.normal.dot(*v);
-        if d < lo {
-            lo = d;
-        }
-        if d > hi {
-            hi = d;
-        }
-    }
+    let (lo, hi) = if scratch.verts.is_empty() {
+        normal_range(vb, front.normal)
+    } else {
+        normal_range_lanes(&scratch.verts, front.normal)
+    };
     let (s0, s1) = (lo - front.offset, -hi - a.faces()[1].offset);
     let (sa, fa) = if s1 > s0 { (s1, 1) } else { (s0, 0) };
     if sa > prediction {
@@ -291,6 +321,47 @@ pub(crate) fn triangle_hull_manifold(
         edge,
         out,
     );
+}
+
+/// The minimum and maximum of `n · v` over the vertices `vb` (infinite when empty; NaN dots
+/// are skipped).
+fn normal_range(vb: &[Vec3], n: Vec3) -> (Real, Real) {
+    let (mut lo, mut hi) = (Real::INFINITY, Real::NEG_INFINITY);
+    for v in vb {
+        let d = n.dot(*v);
+        if d < lo {
+            lo = d;
+        }
+        if d > hi {
+            hi = d;
+        }
+    }
+    (lo, hi)
+}
+
+/// [`normal_range`] over vertex blocks of four lanes ([`EdgeScratch`]'s `verts`): the same
+/// products and sums per vertex and the same strict comparisons, per lane and then across
+/// the lanes, so the same values (a minimum or maximum does not depend on the order in
+/// which it is found, except for the sign of an exact zero).
+fn normal_range_lanes(verts: &[[W; 3]], n: Vec3) -> (Real, Real) {
+    let (nx, ny, nz) = (W::splat(n.x), W::splat(n.y), W::splat(n.z));
+    let (mut lo, mut hi) = (W::splat(Real::INFINITY), W::splat(Real::NEG_INFINITY));
+    for [x, y, z] in verts {
+        let d = *x * nx + *y * ny + *z * nz;
+        lo = d.simd_lt(lo).bitselect(d, lo);
+        hi = d.simd_gt(hi).bitselect(d, hi);
+    }
+    let (lo, hi) = (lo.to_array(), hi.to_array());
+    let (mut l, mut h) = (lo[0], hi[0]);
+    for k in 1..4 {
+        if lo[k] < l {
+            l = lo[k];
+        }
+        if hi[k] > h {
+            h = hi[k];
+        }
+    }
+    (l, h)
 }
 
 /// The edge query of the general path for a flat triangle A and a solid B, with the
@@ -376,13 +447,13 @@ fn triangle_hull_edge_query(
         // both negative, i.e. when bit `k` or bit `k + 3` survives the AND of their signs.
         let mut counts = [0usize; 3];
         for (j, fb) in faces_b.iter().enumerate() {
-            let both = signs[fb[0] as usize] & signs[fb[1] as usize];
+            let both = signs[fb[0] as usize & FACE_MASK] & signs[fb[1] as usize & FACE_MASK];
             let bits = !(both | (both >> 3)) & 0b111;
             if bits == 0 {
                 continue;
             }
             for (k, list) in lists.iter_mut().enumerate() {
-                list[counts[k]] = j as u8;
+                list[counts[k] & (LIST_LEN - 1)] = j as u8;
                 counts[k] += usize::from((bits >> k) & 1 != 0);
             }
         }
@@ -393,7 +464,7 @@ fn triangle_hull_edge_query(
             for &j in &lists[i][..counts[i]] {
                 let j = j as usize;
                 let fb = faces_b[j];
-                let (f0, f1) = (fb[0] as usize, fb[1] as usize);
+                let (f0, f1) = (fb[0] as usize & FACE_MASK, fb[1] as usize & FACE_MASK);
                 let (a0, a1) = (row[f0], row[f1]);
                 // The prefilter with `m · o = a0 (n1 · o) - a1 (n0 · o)` from the faces'
                 // dots with `o`, and `|m|² <= (|a0| + |a1|)²` (unit normals): it drops no

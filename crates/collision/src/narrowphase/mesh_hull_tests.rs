@@ -187,3 +187,58 @@ fn matches_the_general_path_on_degenerate_triangles() {
         }
     }
 }
+
+#[test]
+fn normal_range_lanes_matches_the_scalar_scan() {
+    let mut rng = Rng(0xC0FF_EE00_1234_5678);
+    let hull = taru();
+    for k in 0..2000 {
+        let far = [0.0, 1.0, 1.0e3][k % 3];
+        let pose = Isometry::new(
+            rng.unit() * far,
+            Quat::from_axis_angle(rng.unit(), rng.range(0.0, 3.0)),
+        );
+        let pb = Polyhedron::from_hull(&hull);
+        let posed = posed_hull(&pb, &pose);
+        let scratch = EdgeScratch::new(&pb, &posed);
+        // Random normals, the hull's own (placed) face normals (ties along a face) and
+        // axis directions.
+        let n = match k % 4 {
+            0 => posed.normals[k % posed.normals.len()],
+            1 => [Vec3::X, Vec3::Y, Vec3::Z][k % 3],
+            _ => rng.unit(),
+        };
+        let (l0, h0) = normal_range(&posed.vertices, n);
+        let (l1, h1) = normal_range_lanes(&scratch.verts, n);
+        assert_eq!((l0.to_bits(), h0.to_bits()), (l1.to_bits(), h1.to_bits()));
+    }
+    // Every vertex count from 1 to 9 (padding of a partial block), a NaN vertex (skipped
+    // alike) and a single vertex.
+    for count in 1..10 {
+        let pts: Vec<Vec3> = (0..count).map(|_| rng.unit() * 3.0).collect();
+        let blocks: Vec<[W; 3]> = pts
+            .chunks(4)
+            .map(|c| {
+                let l = [0, 1, 2, 3].map(|i| c.get(i).copied().unwrap_or(pts[0]));
+                [l.map(|v| v.x), l.map(|v| v.y), l.map(|v| v.z)].map(W::new)
+            })
+            .collect();
+        let n = rng.unit();
+        let (l0, h0) = normal_range(&pts, n);
+        let (l1, h1) = normal_range_lanes(&blocks, n);
+        assert_eq!((l0.to_bits(), h0.to_bits()), (l1.to_bits(), h1.to_bits()));
+        assert!(l0 <= h0);
+        let mut with_nan = pts.clone();
+        with_nan[count / 2] = Vec3::new(Real::NAN, 0.0, 0.0);
+        let blocks: Vec<[W; 3]> = with_nan
+            .chunks(4)
+            .map(|c| {
+                let l = [0, 1, 2, 3].map(|i| c.get(i).copied().unwrap_or(with_nan[0]));
+                [l.map(|v| v.x), l.map(|v| v.y), l.map(|v| v.z)].map(W::new)
+            })
+            .collect();
+        let (l0, h0) = normal_range(&with_nan, Vec3::X);
+        let (l1, h1) = normal_range_lanes(&blocks, Vec3::X);
+        assert_eq!((l0.to_bits(), h0.to_bits()), (l1.to_bits(), h1.to_bits()));
+    }
+}
