@@ -18,7 +18,7 @@
 
 use super::contact::{ContactList, FeatureId};
 use super::manifold::Separation;
-use super::polyhedron::{polyhedron_manifold_guided, Polyhedron, EPA_FEATURE};
+use super::polyhedron::{polyhedron_manifold_guided, Polyhedron, BOX_LOOPS, EPA_FEATURE};
 use super::polyhedron_guided::witness_realises_depth;
 use crate::math::{Isometry, Mat3, Real, Vec3};
 use crate::query::contact_cuboid_cuboid::{
@@ -209,7 +209,11 @@ impl Poly {
 /// within `prediction` of the reference face are appended in the reference frame (normal
 /// from the reference towards the incident box), with feature ids in `clip_faces`' layout:
 /// `id_base | face << 16 | corner << 8 | 0xFF` for incident corners, the corner's id with
-/// the side plane's index in the low byte for points made by the clip. Nothing is appended
+/// the side plane's index in the low byte for points made by the clip, and in its order:
+/// the incident corners in their face's outward loop ([`BOX_LOOPS`]), the side planes in the
+/// order of the reference face's loop edges. (The solver sweeps a manifold's points in
+/// order; listing every face's corners the same way round made the 20-row pyramid of
+/// `pipeline_stacking` creep 2.2 cm in 2000 steps instead of 0.7.) Nothing is appended
 /// when the incident face misses the reference face's prism (the caller then falls back).
 /// `rot_ri` is `pose_ri.rotation_matrix()`, built once by the caller.
 #[allow(clippy::too_many_arguments)]
@@ -227,6 +231,33 @@ fn clip_box_faces(
     clip_box_faces_with(hr, rf, hi, rot_ri, t, prediction, id_base, |c, id| {
         out.push((c, id))
     });
+}
+
+/// The side planes `s · x_k <= h_k` of each box face, in the order of the edges of the
+/// face's loop in [`BOX_LOOPS`] (edge `a → b` bounds the plane along `(b − a) × n`).
+const SIDE_PLANES: [[(usize, Real); 4]; 6] = side_planes();
+
+const fn side_planes() -> [[(usize, Real); 4]; 6] {
+    let mut out = [[(0usize, 0.0 as Real); 4]; 6];
+    let mut f = 0;
+    while f < 6 {
+        let i = f / 2;
+        let sn: i32 = if f % 2 == 0 { 1 } else { -1 };
+        let mut e = 0;
+        while e < 4 {
+            let a = BOX_LOOPS[4 * f + e];
+            let b = BOX_LOOPS[4 * f + (e + 1) % 4];
+            let d = (a ^ b).trailing_zeros() as usize;
+            let sd: i32 = if b & (1 << d) != 0 { 1 } else { -1 };
+            // e_d × e_i = ε(d, i, k) e_k with k the third axis.
+            let k = 3 - d - i;
+            let eps: i32 = if (d + 1) % 3 == i { 1 } else { -1 };
+            out[f][e] = (k, (sd * sn * eps) as Real);
+            e += 1;
+        }
+        f += 1;
+    }
+    out
 }
 
 /// [`clip_box_faces`] with the incident box's pose given as its rotation matrix `rot` and
@@ -271,13 +302,22 @@ fn clip_box_faces_with(
     let (u, v) = (axes[k1] * hi[k1], axes[k2] * hi[k2]);
     let id = id_base | ((inc_face as u32 & 0xFF) << 16) | 0xFF;
     let mut bufs = [Poly::EMPTY; 2];
-    for (k, c) in [u + v, v - u, -u - v, u - v].into_iter().enumerate() {
-        let _ = bufs[0].push((centre + c).to_array(), id | ((k as u32 & 0xFF) << 8));
+    // The incident face's corners in the polyhedron's loop order (outward, counter-clockwise),
+    // so the points, their ids and their order are the general clipper's.
+    for (k, &c) in BOX_LOOPS[4 * inc_face..4 * inc_face + 4].iter().enumerate() {
+        let su = if c & (1 << k1) != 0 { u } else { -u };
+        let sv = if c & (1 << k2) != 0 { v } else { -v };
+        let _ = bufs[0].push(
+            (centre + (su + sv)).to_array(),
+            id | ((k as u32 & 0xFF) << 8),
+        );
     }
     let mut cur = 0;
     let mut tag = 0;
-    for k in [(i + 1) % 3, (i + 2) % 3] {
-        for s in [1.0 as Real, -1.0] {
+    // The reference face's side planes in the order of its loop's edges (the tags of the
+    // general clipper).
+    for &(k, s) in &SIDE_PLANES[rf] {
+        {
             let limit = hr[k];
             // Each corner's signed distance to the side plane, once (the loop below used to
             // compute it twice, as an edge's start and as the previous edge's end). When every
@@ -425,14 +465,20 @@ mod tests {
         let (k1, k2) = ((j + 1) % 3, (j + 2) % 3);
         let (u, v) = (axes[k1] * hi[k1], axes[k2] * hi[k2]);
         let id = ((inc_face as u32 & 0xFF) << 16) | 0xFF;
-        let mut poly: Vec<([Real; 3], u32)> = [u + v, v - u, -u - v, u - v]
-            .into_iter()
+        let mut poly: Vec<([Real; 3], u32)> = BOX_LOOPS[4 * inc_face..4 * inc_face + 4]
+            .iter()
             .enumerate()
-            .map(|(k, c)| ((centre + c).to_array(), id | ((k as u32 & 0xFF) << 8)))
+            .map(|(k, &c)| {
+                let su = if c & (1 << k1) != 0 { u } else { -u };
+                let sv = if c & (1 << k2) != 0 { v } else { -v };
+                (
+                    (centre + (su + sv)).to_array(),
+                    id | ((k as u32 & 0xFF) << 8),
+                )
+            })
             .collect();
-        let mut tag = 0;
-        for k in [(i + 1) % 3, (i + 2) % 3] {
-            for s in [1.0 as Real, -1.0] {
+        for (tag, &(k, s)) in (0u32..).zip(&SIDE_PLANES[rf]) {
+            {
                 let limit = hr[k];
                 let mut next_poly = Vec::new();
                 let n = poly.len();
@@ -456,7 +502,6 @@ mod tests {
                 if poly.is_empty() {
                     return;
                 }
-                tag += 1;
             }
         }
         for (p, fid) in poly {
@@ -676,5 +721,88 @@ mod tests {
             }
         }
         assert!(nonempty > 5000, "{nonempty}");
+    }
+
+    /// The box clip is the general polyhedron clipper (`clip_faces` on the boxes as
+    /// polyhedra) specialised: the same points (to round-off), the same ids, in the same
+    /// order. The order matters to the solver, which sweeps a manifold's points in turn: with
+    /// the incident corners listed one way round for every face (the first version of this
+    /// clip), the release-mode 20-row pyramid of `pipeline_stacking` crept 2.2 cm in 2000
+    /// steps; in the polyhedron's outward loop order it creeps 0.7 cm, as before the clip.
+    #[test]
+    fn clip_matches_the_polyhedron_clipper_in_order() {
+        let mut seed = 0x005e_ed0f_c11f_u64;
+        let mut rnd = || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as Real / (1u64 << 53) as Real
+        };
+        let mut compared = 0;
+        for case in 0..20000 {
+            let far = if case % 3 == 0 { 1000.0 } else { 0.0 };
+            let mut h = || Vec3::new(0.05 + rnd(), 0.05 + rnd(), 0.05 + rnd());
+            let (hr, hi) = (h(), h());
+            let rf = (6.0 * rnd()) as usize % 6;
+            let rot = match case % 4 {
+                0 => Quat::IDENTITY,
+                1 => Quat::from_rotation_y(rnd() * 6.0) * Quat::from_rotation_x(1e-4 * rnd()),
+                _ => Quat::from_axis_angle(
+                    Vec3::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5).normalize(),
+                    rnd() * 6.0,
+                ),
+            };
+            let mut nr = Vec3::ZERO;
+            nr[rf / 2] = if rf.is_multiple_of(2) { 1.0 } else { -1.0 };
+            let off = Vec3::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5) * 1.5;
+            // 1 km out: the reference face (and the incident box over it) 1 km from the
+            // reference box's centre.
+            let mut hr_far = hr;
+            hr_far[rf / 2] += far;
+            let t = nr * (hr_far[rf / 2] + hi.min_element() * 0.5) + off;
+            let pose = Isometry::new(t, rot);
+            let cuboid = |h: Vec3| crate::shape::Cuboid::new(h).unwrap();
+            let (pr, pi) = (
+                Polyhedron::from_cuboid(&cuboid(hr_far)),
+                Polyhedron::from_cuboid(&cuboid(hi)),
+            );
+            for prediction in [0.02 as Real, 10.0] {
+                let (mut got, mut want) = (Vec::new(), Vec::new());
+                clip_box_faces(
+                    hr_far,
+                    rf,
+                    hi,
+                    &pose.rotation_matrix(),
+                    &pose,
+                    prediction,
+                    0,
+                    &mut got,
+                );
+                super::super::polyhedron::clip_faces(&pr, rf, &pi, &pose, prediction, 0, &mut want);
+                if got.is_empty() {
+                    // The general clipper then falls back to one vertex; the box caller
+                    // takes the guided path instead.
+                    assert!(want.iter().all(|w| w.1 & 0xFFFF == 0xFEFF), "case {case}");
+                    continue;
+                }
+                // The two clippers round differently (a coordinate against a plane through
+                // an edge): points made by a clip of a nearly parallel edge differ most.
+                let scale = 1.0 + far;
+                assert_eq!(got.len(), want.len(), "case {case}");
+                for (g, w) in got.iter().zip(&want) {
+                    assert_eq!(g.1, w.1, "case {case}");
+                    assert!(
+                        (g.0.point_b - w.0.point_b).length() <= 1e-4 * scale,
+                        "case {case}: {g:?} vs {w:?}"
+                    );
+                    assert!(
+                        (g.0.distance - w.0.distance).abs() <= 1e-4 * scale,
+                        "case {case}"
+                    );
+                }
+                compared += 1;
+            }
+        }
+        assert!(compared > 10000, "{compared}");
     }
 }

@@ -58,7 +58,7 @@ pub struct Polyhedron<'a> {
 }
 
 /// Corner `i` of a box has coordinate signs from bits 0 (x), 1 (y), 2 (z).
-const BOX_LOOPS: [u32; 24] = [
+pub(crate) const BOX_LOOPS: [u32; 24] = [
     1, 3, 7, 5, 0, 4, 6, 2, 2, 6, 7, 3, 0, 1, 5, 4, 4, 5, 7, 6, 0, 2, 3, 1,
 ];
 /// The box's edges as corner pairs (the lower corner has the edge's axis bit clear).
