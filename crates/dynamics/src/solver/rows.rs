@@ -318,24 +318,11 @@ impl Block {
             [r0] => (e(r0, r0), 0.0, 0.0, 1.0, 0.0, 1.0),
             _ => (1.0, 0.0, 0.0, 1.0, 0.0, 1.0),
         };
-        // Cofactors: K⁻¹ = C / det for a symmetric K.
-        let c00 = k11 * k22 - k12 * k12;
-        let c01 = k02 * k12 - k01 * k22;
-        let c02 = k01 * k12 - k02 * k11;
-        let det = k00 * c00 + k01 * c01 + k02 * c02;
-        let diag = k00 * k11 * k22;
-        // Relative conditioning test: a nearly singular K is solved row by row instead.
-        self.valid = det.is_finite() && diag > 0.0 && det > 1e-4 * diag;
-        if self.valid {
-            let c11 = k00 * k22 - k02 * k02;
-            let c12 = k01 * k02 - k00 * k12;
-            let c22 = k00 * k11 - k01 * k01;
-            let inv_det = 1.0 / det;
-            self.inv_k = [
-                Vec3A::new(c00, c01, c02) * inv_det,
-                Vec3A::new(c01, c11, c12) * inv_det,
-                Vec3A::new(c02, c12, c22) * inv_det,
-            ];
+        // A nearly singular K is solved row by row instead.
+        let inv = inverse_symmetric(k00, k01, k02, k11, k12, k22);
+        self.valid = inv.is_some();
+        if let Some(inv_k) = inv {
+            self.inv_k = inv_k;
         } else {
             for r in rows.iter_mut() {
                 r.finish(p);
@@ -490,23 +477,11 @@ impl PointBlock {
         // The upper triangle of the symmetric K.
         let (k00, k01, k02) = (k[0].x, k[1].x, k[2].x);
         let (k11, k12, k22) = (k[1].y, k[2].y, k[2].z);
-        let c00 = k11 * k22 - k12 * k12;
-        let c01 = k02 * k12 - k01 * k22;
-        let c02 = k01 * k12 - k02 * k11;
-        let det = k00 * c00 + k01 * c01 + k02 * c02;
-        let diag = k00 * k11 * k22;
-        // The same relative conditioning test as `Block::update`.
-        self.valid = det.is_finite() && diag > 0.0 && det > 1e-4 * diag;
-        if self.valid {
-            let c11 = k00 * k22 - k02 * k02;
-            let c12 = k01 * k02 - k00 * k12;
-            let c22 = k00 * k11 - k01 * k01;
-            let inv_det = 1.0 / det;
-            self.inv_k = [
-                Vec3A::new(c00, c01, c02) * inv_det,
-                Vec3A::new(c01, c11, c12) * inv_det,
-                Vec3A::new(c02, c12, c22) * inv_det,
-            ];
+        // The same inverse and conditioning test as `Block::update`.
+        let inv = inverse_symmetric(k00, k01, k02, k11, k12, k22);
+        self.valid = inv.is_some();
+        if let Some(inv_k) = inv {
+            self.inv_k = inv_k;
         } else {
             self.inv_k = [
                 Vec3A::new(inv_or_zero(k00), 0.0, 0.0),
@@ -567,6 +542,37 @@ impl PointBlock {
     }
 }
 
+/// The inverse of a symmetric 3×3 `K` given by its upper triangle, by cofactors
+/// (`K⁻¹ = C / det`), as its three columns (equal to its rows); `None` when `K` is nearly
+/// singular by the relative test `det > 1e-4 · k00 k11 k22` (or not finite), for the
+/// caller's row-by-row fallback. Shared by [`Block::update`] and [`PointBlock::update`].
+#[inline(always)]
+fn inverse_symmetric(
+    k00: Real,
+    k01: Real,
+    k02: Real,
+    k11: Real,
+    k12: Real,
+    k22: Real,
+) -> Option<[Vec3A; 3]> {
+    let c00 = k11 * k22 - k12 * k12;
+    let c01 = k02 * k12 - k01 * k22;
+    let c02 = k01 * k12 - k02 * k11;
+    let det = k00 * c00 + k01 * c01 + k02 * c02;
+    let diag = k00 * k11 * k22;
+    if !(det.is_finite() && diag > 0.0 && det > 1e-4 * diag) {
+        return None;
+    }
+    let c11 = k00 * k22 - k02 * k02;
+    let c12 = k01 * k02 - k00 * k12;
+    let c22 = k00 * k11 - k01 * k01;
+    let inv_det = 1.0 / det;
+    Some([
+        Vec3A::new(c00, c01, c02) * inv_det,
+        Vec3A::new(c01, c11, c12) * inv_det,
+        Vec3A::new(c02, c12, c22) * inv_det,
+    ])
+}
 #[cfg(test)]
 mod tests {
     use super::*;
