@@ -7,7 +7,11 @@
 //! times, the median of the per-step ratios, and the whole-step and per-stage (solver,
 //! narrowphase) ratios. As a control of how much of a second core the machine gives, each
 //! step is followed by the same embarrassingly parallel loop (sines, about 1 ms on one
-//! thread) in both pools: its median ratio is the speed-up the machine allows at that time.
+//! thread) in both pools: its median ratio is the speed-up the machine allows at that time
+//! for compute-bound work. A second control streams an 8 MB buffer (read, scale, write back,
+//! several times the cores' L2): its ratio is what the machine's memory bandwidth allows a
+//! stage that streams data out of cache (on the 2-core VM of the bench, about 1.1x against
+//! 1.7x for the compute control).
 //!
 //! `cargo run --release -p carom-dynamics --example parallel_scaling -- [scene 1–8] [steps]
 //! [threads]`
@@ -33,6 +37,13 @@ fn control() -> f64 {
         .sum()
 }
 
+/// The memory-bound control: one pass of `x ← 1.0001 x + 0.5` over `buf`, in chunks.
+fn stream(buf: &mut [f32]) {
+    use rayon::prelude::*;
+    buf.par_chunks_mut(16_384)
+        .for_each(|c| c.iter_mut().for_each(|x| *x = *x * 1.0001 + 0.5));
+}
+
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut args = std::env::args().skip(1);
     let number: usize = args.next().and_then(|s| s.parse().ok()).unwrap_or(2);
@@ -55,6 +66,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut times = [[vec![], vec![], vec![]], [vec![], vec![], vec![]]];
     let mut ratios = vec![];
     let mut controls = vec![];
+    let mut streams = vec![];
+    let mut buf = vec![1.0f32; 2 << 20];
     // Per side: the solver's sub-stages (islands, prepare, forces, warm start, solve,
     // integrate, relax, restitution, store), per step.
     let mut subs: [[Vec<f64>; 9]; 2] = Default::default();
@@ -92,6 +105,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             c[side] = t0.elapsed().as_secs_f64();
         }
         controls.push(c[0] / c[1]);
+        for side in 0..2 {
+            let t0 = Instant::now();
+            pools[side].install(|| stream(&mut buf));
+            c[side] = t0.elapsed().as_secs_f64();
+        }
+        streams.push(c[0] / c[1]);
     }
     let same = worlds[0].dynamics().state_hash() == worlds[1].dynamics().state_hash();
     let m: Vec<[f64; 3]> = times
@@ -101,7 +120,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     println!(
         "scene {number}, {steps} steps, 1 vs {threads} threads (medians, ms/step): \
          step {:.3} vs {:.3} = {:.2}x, solver {:.3} vs {:.3} = {:.2}x, narrowphase {:.3} vs \
-         {:.3} = {:.2}x; median per-step ratio {:.2}x; control {:.2}x; bit-identical: {same}",
+         {:.3} = {:.2}x; median per-step ratio {:.2}x; control {:.2}x (compute), {:.2}x \
+         (8 MB stream); bit-identical: {same}",
         m[0][0],
         m[1][0],
         m[0][0] / m[1][0],
@@ -113,6 +133,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         m[0][2] / m[1][2],
         median(&mut ratios),
         median(&mut controls),
+        median(&mut streams),
     );
     let names = [
         "islands",
