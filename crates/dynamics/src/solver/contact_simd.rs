@@ -16,11 +16,6 @@
 //! physics; the grouping depends only on the colour order, never on the thread count.
 //! The lane type is selected from [`Real`] in one place ([`W`]): `f32x4` or `f64x4`.
 
-#[cfg(test)]
-use super::coloring::solve_coloured;
-#[cfg(test)]
-use super::contact::ContactConstraint;
-use super::SolverBody;
 use crate::contact::MAX_MANIFOLD_POINTS;
 use carom_collision::math::Real;
 use std::ops::Range;
@@ -32,6 +27,18 @@ pub(crate) use build::store;
 pub(crate) use build::{assign, build_range, store_range};
 #[cfg(test)]
 pub(crate) use build::{build, fill, write_back};
+
+#[path = "contact_simd_run.rs"]
+mod run;
+pub(crate) use run::{solve_range, Restitution, SoftSolve, WarmStart};
+#[cfg(test)]
+pub(crate) use run::{solve_range_on, Isa};
+
+#[cfg(test)]
+#[path = "contact_simd_drivers.rs"]
+mod drivers;
+#[cfg(test)]
+pub(crate) use drivers::solve;
 
 /// Maps a scalar type to its four-lane vector.
 pub(crate) trait Lanes {
@@ -246,77 +253,6 @@ pub(crate) struct WideBody {
     inv_m: W,
 }
 
-/// Gathers the bodies of `slots` into lanes (`b2GatherBodies`); padding lanes are a
-/// motionless static body. Each body's `v, w, dp, dq` are twelve consecutive scalars
-/// ([`SolverBody::state`]), read as three four-wide rows and transposed with three 4×4
-/// transposes, which leave exactly the twelve lane vectors (`v.x … dq.z`).
-#[inline(always)]
-fn gather(bodies: &[SolverBody], slots: &[u32; LANES], inv_m: W) -> WideBody {
-    let row = |s: u32| {
-        if s == NO_SLOT {
-            [[0.0; LANES]; 3]
-        } else {
-            bodies[s as usize].state()
-        }
-    };
-    // Not `slots.map`: that call was left out of line in the stage executor (module
-    // `soft_stages`), 100 M instructions in 60 steps of "1000 stack".
-    let rows = [row(slots[0]), row(slots[1]), row(slots[2]), row(slots[3])];
-    let t = |k: usize| W::transpose(rows.map(|r| W::new(r[k])));
-    let ([vx, vy, vz, wx], [wy, wz, px, py], [pz, qx, qy, qz]) = (t(0), t(1), t(2));
-    WideBody {
-        v: V3 {
-            x: vx,
-            y: vy,
-            z: vz,
-        },
-        w: V3 {
-            x: wx,
-            y: wy,
-            z: wz,
-        },
-        dp: V3 {
-            x: px,
-            y: py,
-            z: pz,
-        },
-        dq: V3 {
-            x: qx,
-            y: qy,
-            z: qz,
-        },
-        inv_m,
-    }
-}
-
-/// Writes the velocities of the lanes with `write[l]` (dynamic bodies) back
-/// (`b2ScatterBodies`): two 4×4 transposes give each lane's `v, w` (and its unchanged
-/// `dp.x, dp.y`) as two rows.
-///
-/// # Safety
-/// `bodies` points to `len` solver bodies, and no other live reference touches the bodies
-/// written during the call (the colouring guarantees it for one colour).
-#[inline(always)]
-unsafe fn scatter(
-    body: &WideBody,
-    bodies: *mut SolverBody,
-    len: usize,
-    slots: &[u32; LANES],
-    write: &[bool; LANES],
-) {
-    let r0 = W::transpose([body.v.x, body.v.y, body.v.z, body.w.x]);
-    let r1 = W::transpose([body.w.y, body.w.z, body.dp.x, body.dp.y]);
-    for l in 0..LANES {
-        if !write[l] {
-            continue;
-        }
-        let s = slots[l] as usize;
-        assert!(s < len);
-        let target = &mut *bodies.add(s);
-        target.set_velocities(r0[l].to_array(), r1[l].to_array());
-    }
-}
-
 /// The wide constraints of a step, reused from step to step (cleared, not freed).
 #[derive(Debug, Clone, Default)]
 pub(crate) struct WideScratch {
@@ -331,157 +267,8 @@ pub(crate) struct WideScratch {
     pub members: Vec<[usize; LANES]>,
 }
 
-/// Raw access to the solver bodies while one colour is solved.
-#[derive(Clone, Copy)]
-struct Bodies {
-    ptr: *mut SolverBody,
-    len: usize,
-}
-
-// SAFETY: used only to solve the wide constraints of one colour, which write disjoint
-// dynamic bodies (the colouring guarantees it) and never write non-dynamic ones.
-unsafe impl Send for Bodies {}
-unsafe impl Sync for Bodies {}
-
-impl Bodies {
-    /// Gathers, runs `f` and scatters one wide constraint.
-    ///
-    /// # Safety
-    /// No other live reference may touch the dynamic bodies of `c` during the call.
-    #[inline(always)]
-    unsafe fn run<F, A>(self, c: &mut WideConstraint, f: &F, active: &A)
-    where
-        F: Fn(&mut WideConstraint, &mut WideBody, &mut WideBody),
-        A: Fn(&WideConstraint) -> bool,
-    {
-        if !active(c) {
-            return;
-        }
-        let all = std::slice::from_raw_parts(self.ptr as *const SolverBody, self.len);
-        let mut a = gather(all, &c.a, c.inv_m_a);
-        let mut b = gather(all, &c.b, c.inv_m_b);
-        f(c, &mut a, &mut b);
-        scatter(&a, self.ptr, self.len, &c.a, &c.write_a);
-        scatter(&b, self.ptr, self.len, &c.b, &c.write_b);
-    }
-}
-
-/// Runs `f` (where `active` holds) on the wide constraints `range` of `cons`, one after
-/// another: one block of a colour in the stage-parallel soft step (module `stages`).
-///
-/// # Safety
-/// `cons` points to at least `range.end` wide constraints and `bodies` to `len` solver
-/// bodies; during the call no other live reference touches those constraints or their
-/// dynamic bodies (true for disjoint blocks of one colour). Not inlined, so each pass is one
-/// function in which the gather and scatter are inlined (inlined into the caller's larger
-/// stage executor they were not, which cost 5 % of the solver's instructions).
-#[inline(never)]
-pub(crate) unsafe fn solve_range<F, A>(
-    cons: *mut WideConstraint,
-    range: Range<usize>,
-    bodies: *mut SolverBody,
-    len: usize,
-    f: &F,
-    active: &A,
-) where
-    F: Fn(&mut WideConstraint, &mut WideBody, &mut WideBody),
-    A: Fn(&WideConstraint) -> bool,
-{
-    let shared = Bodies { ptr: bodies, len };
-    for i in range {
-        shared.run(&mut *cons.add(i), f, active);
-    }
-}
-
-/// Runs `wide_fn` on every wide constraint, colour by colour (in parallel inside a colour of
-/// at least `min_batch` constraints when `parallel`), then `scalar_fn` on the overflow
-/// colour of `cons`. Same bits whatever the thread count; no allocation. The soft step runs
-/// the colours through its stage list instead (module `soft_stages`, [`solve_range`]); this
-/// driver is the tests' reference.
-#[cfg(test)]
-pub(crate) fn solve<F, S>(
-    wide: &mut WideScratch,
-    cons: &mut [ContactConstraint],
-    bodies: &mut [SolverBody],
-    parallel: bool,
-    min_batch: usize,
-    wide_fn: F,
-    scalar_fn: S,
-) where
-    F: Fn(&mut WideConstraint, &mut WideBody, &mut WideBody) + Sync,
-    S: Fn(&mut ContactConstraint, &mut SolverBody, &mut SolverBody) + Sync,
-{
-    solve_active(
-        wide,
-        cons,
-        bodies,
-        (parallel, min_batch),
-        |_| true,
-        wide_fn,
-        scalar_fn,
-    );
-}
-
-/// [`solve`] on the wide constraints for which `active` holds; the others are skipped
-/// without gathering their bodies (e.g. restitution on constraints without restitution).
-#[cfg(test)]
-pub(crate) fn solve_active<A, F, S>(
-    wide: &mut WideScratch,
-    cons: &mut [ContactConstraint],
-    bodies: &mut [SolverBody],
-    (parallel, min_batch): (bool, usize),
-    active: A,
-    wide_fn: F,
-    scalar_fn: S,
-) where
-    A: Fn(&WideConstraint) -> bool + Sync,
-    F: Fn(&mut WideConstraint, &mut WideBody, &mut WideBody) + Sync,
-    S: Fn(&mut ContactConstraint, &mut SolverBody, &mut SolverBody) + Sync,
-{
-    for r in &wide.ranges {
-        let chunk = &mut wide.cons[r.clone()];
-        let shared = Bodies {
-            ptr: bodies.as_mut_ptr(),
-            len: bodies.len(),
-        };
-        let go_parallel = parallel && chunk.len() * LANES >= min_batch.max(2);
-        if go_parallel && solve_parallel(chunk, shared, &wide_fn, &active) {
-            continue;
-        }
-        for c in chunk.iter_mut() {
-            // SAFETY: `shared` is the only access to `bodies` here; one constraint at a time.
-            unsafe { shared.run(c, &wide_fn, &active) };
-        }
-    }
-    let overflow = wide.overflow.clone();
-    solve_coloured(cons, &[overflow], bodies, false, min_batch, scalar_fn);
-}
-
-#[cfg(all(test, feature = "parallel"))]
-fn solve_parallel<F, A>(chunk: &mut [WideConstraint], shared: Bodies, f: &F, active: &A) -> bool
-where
-    F: Fn(&mut WideConstraint, &mut WideBody, &mut WideBody) + Sync,
-    A: Fn(&WideConstraint) -> bool + Sync,
-{
-    use rayon::prelude::*;
-    if rayon::current_num_threads() < 2 {
-        return false;
-    }
-    // SAFETY: the wide constraints of one colour share no dynamic body, so the parallel
-    // calls write disjoint bodies; non-dynamic bodies are only read.
-    chunk
-        .par_iter_mut()
-        .with_min_len(16)
-        .for_each(|c| unsafe { shared.run(c, f, active) });
-    true
-}
-
-#[cfg(all(test, not(feature = "parallel")))]
-fn solve_parallel<F, A>(_: &mut [WideConstraint], _: Bodies, _: &F, _: &A) -> bool {
-    false
-}
-
 /// Warm start, as `contact::warm_start` in every lane.
+#[inline(always)]
 pub(crate) fn warm_start(c: &mut WideConstraint, a: &mut WideBody, b: &mut WideBody) {
     let (tx, ty) = (c.tangent, c.tangent1());
     for p in &c.points[..c.len] {
@@ -587,6 +374,7 @@ fn solve_friction(c: &mut WideConstraint, a: &mut WideBody, b: &mut WideBody, li
 /// Soft-step solve (`b2SolveContactTwoPointsTask`), as `contact::solve_soft` in every lane:
 /// friction, then the normal rows with soft feedback when `use_bias` (relax otherwise). The
 /// linear velocities follow the constraint frame ([`Linear`]), as in the scalar routine.
+#[inline(always)]
 pub(crate) fn solve_soft(
     c: &mut WideConstraint,
     a: &mut WideBody,
@@ -646,6 +434,7 @@ pub(crate) fn has_restitution(c: &WideConstraint) -> bool {
 /// Restitution pass (`b2ApplyRestitution`), as `contact::apply_restitution` in every lane:
 /// lanes that did not approach faster than `threshold`, carried no impulse or have no
 /// restitution are left unchanged.
+#[inline(always)]
 pub(crate) fn apply_restitution(
     c: &mut WideConstraint,
     a: &mut WideBody,

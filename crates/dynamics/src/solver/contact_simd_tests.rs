@@ -601,3 +601,67 @@ fn lane_assignment_matches_the_four_pass_rule() {
         assert_eq!(wide.cons.len(), members.len());
     }
 }
+
+/// Every instruction set the CPU has runs the production kernels ([`WarmStart`],
+/// [`SoftSolve`], [`Restitution`]) to the scalar routines' bits: the AVX and AVX-512 copies
+/// of the passes differ from the baseline only in encoding and register allocation.
+#[test]
+fn every_instruction_set_gives_the_scalar_bits() {
+    let best = Isa::detect();
+    let isas = [Isa::Base, Isa::Avx, Isa::Avx512]
+        .into_iter()
+        .filter(|&i| i == Isa::Base || i == best || (i == Isa::Avx && best == Isa::Avx512));
+    for isa in isas {
+        let mut rng = Rng(0x2545_f491_4f6c_dd1d);
+        for count in [1, 4, 7, 16] {
+            let (mut bodies, mut cons) = scene(&mut rng, count);
+            let (mut bodies2, mut cons2) = (bodies.clone(), cons.clone());
+            let ranges = [0..count, count..count];
+            let mut wide = WideScratch::default();
+            build(&cons, &ranges, &bodies, &mut wide);
+            let inv_h = 240.0;
+            for pass in 0..4 {
+                let scalar = |c: &mut ContactConstraint, a: &mut SolverBody, b: &mut SolverBody| {
+                    match pass {
+                        0 => contact::warm_start(c, a, b),
+                        1 => contact::solve_soft(c, a, b, inv_h, 3.0, true),
+                        2 => contact::solve_soft(c, a, b, inv_h, 3.0, false),
+                        _ => contact::apply_restitution(c, a, b, 1.0),
+                    }
+                };
+                let (cs, n) = (wide.cons.as_mut_ptr(), wide.cons.len());
+                let (bs, nb) = (bodies.as_mut_ptr(), bodies.len());
+                let all = |_: &WideConstraint| true;
+                let solve = |use_bias| SoftSolve {
+                    inv_h,
+                    max_push: 3.0,
+                    use_bias,
+                };
+                // SAFETY: `cs`, `bs` are the only access to the constraints and bodies here,
+                // and `isa` is one the CPU has.
+                unsafe {
+                    match pass {
+                        0 => solve_range_on(isa, cs, 0..n, bs, nb, &WarmStart, &all),
+                        1 => solve_range_on(isa, cs, 0..n, bs, nb, &solve(true), &all),
+                        2 => solve_range_on(isa, cs, 0..n, bs, nb, &solve(false), &all),
+                        _ => {
+                            let r = Restitution { threshold: 1.0 };
+                            solve_range_on(isa, cs, 0..n, bs, nb, &r, &has_restitution)
+                        }
+                    }
+                }
+                super::super::coloring::solve_coloured(
+                    &mut cons2,
+                    &ranges,
+                    &mut bodies2,
+                    false,
+                    1,
+                    scalar,
+                );
+                write_back(&wide, &mut cons);
+                same_bits(&bodies, &bodies2, &cons, &cons2);
+            }
+            assert_eq!(bodies[0], bodies2[0], "{isa:?}: static body written");
+        }
+    }
+}

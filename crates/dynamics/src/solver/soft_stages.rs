@@ -25,7 +25,7 @@
 
 use super::coloring;
 use super::contact::{self, ContactConstraint, ContactScratch};
-use super::contact_simd::{self, WideBody, WideConstraint};
+use super::contact_simd::{self, WideConstraint};
 use super::joints::{JointPass, JointScratch, JointView};
 use super::stages::{block_count, block_range, StageList};
 use super::{Softness, SolverBody};
@@ -527,15 +527,20 @@ impl Shared<'_> {
         let all = |_: &WideConstraint| true;
         let cons = self.wide;
         match pass {
-            Pass::WarmStart => contact_simd::solve_range(cons, range, b, n, &wide_warm_start, &all),
+            Pass::WarmStart => {
+                contact_simd::solve_range(cons, range, b, n, &contact_simd::WarmStart, &all)
+            }
             Pass::Solve | Pass::Relax => {
-                let bias = pass == Pass::Solve;
-                let f =
-                    |w: &mut _, x: &mut _, y: &mut _| wide_solve(w, x, y, inv_h, max_push, bias);
+                let use_bias = pass == Pass::Solve;
+                let f = contact_simd::SoftSolve {
+                    inv_h,
+                    max_push,
+                    use_bias,
+                };
                 contact_simd::solve_range(cons, range, b, n, &f, &all);
             }
             Pass::Restitution => {
-                let f = |w: &mut _, x: &mut _, y: &mut _| wide_restitution(w, x, y, threshold);
+                let f = contact_simd::Restitution { threshold };
                 let active = contact_simd::has_restitution;
                 contact_simd::solve_range(cons, range, b, n, &f, &active);
             }
@@ -564,29 +569,4 @@ impl Shared<'_> {
             }
         }
     }
-}
-
-// The wide kernels behind calls that are not inlined: inlined into `solve_range`, they left
-// the gather's array maps out of line (+4.6 % instructions on "1000 stack", callgrind).
-
-#[inline(never)]
-fn wide_warm_start(c: &mut WideConstraint, a: &mut WideBody, b: &mut WideBody) {
-    contact_simd::warm_start(c, a, b);
-}
-
-#[inline(never)]
-fn wide_solve(
-    c: &mut WideConstraint,
-    a: &mut WideBody,
-    b: &mut WideBody,
-    inv_h: Real,
-    max_push: Real,
-    bias: bool,
-) {
-    contact_simd::solve_soft(c, a, b, inv_h, max_push, bias);
-}
-
-#[inline(never)]
-fn wide_restitution(c: &mut WideConstraint, a: &mut WideBody, b: &mut WideBody, threshold: Real) {
-    contact_simd::apply_restitution(c, a, b, threshold);
 }
