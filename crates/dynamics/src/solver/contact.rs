@@ -13,6 +13,12 @@ use crate::body_set::BodySet;
 use crate::contact::{ContactManifold, MAX_MANIFOLD_POINTS};
 use carom_collision::math::{orthonormal_basis, Real, Vec3};
 
+#[cfg(test)]
+#[path = "contact_tests.rs"]
+mod tests;
+#[cfg(test)]
+pub(crate) use tests::solve_soft_rows;
+
 /// One Jacobian row of a contact point along a unit direction `d` (the normal or a tangent):
 /// the angular parts `r_a × d`, `r_b × d` and the same premultiplied by the inverse world
 /// inertias, so a solve is dot products and scaled adds only (no matrix product, no cross
@@ -635,32 +641,6 @@ fn soft_terms(
         )
     } else {
         (0.0, 1.0, 0.0)
-    }
-}
-
-/// [`solve_soft`] applying every row to the bodies (the form before [`FrameVelocity`]): the
-/// oracle of the frame form's test.
-#[cfg(test)]
-pub(crate) fn solve_soft_rows(
-    c: &mut ContactConstraint,
-    a: &mut SolverBody,
-    b: &mut SolverBody,
-    inv_h: Real,
-    max_push: Real,
-    use_bias: bool,
-) {
-    solve_friction(c, a, b);
-    let (linear, soft) = (c.normal.dot(b.dp - a.dp), c.softness);
-    for p in c.points[..c.len].iter_mut() {
-        let row = &p.normal_row;
-        let s = p.separation + row.displacement(linear, a, b);
-        let (bias, mass_scale, impulse_scale) = soft_terms(soft, s, inv_h, max_push, use_bias);
-        let vn = row.velocity(c.normal, a, b);
-        let lambda = -row.mass * mass_scale * (vn + bias) - impulse_scale * p.normal_impulse;
-        let new = (p.normal_impulse + lambda).max(0.0);
-        row.apply(c.normal, new - p.normal_impulse, a, b);
-        p.normal_impulse = new;
-        p.max_normal_impulse = p.max_normal_impulse.max(new);
     }
 }
 
