@@ -1,7 +1,7 @@
 //! Test-only companions of the contact solve (module `contact`): the row-by-row oracle of
 //! the frame-velocity solve, used by `contact_simd_tests.rs`.
 
-use super::{solve_friction, soft_terms, ContactConstraint, SolverBody};
+use super::{soft_terms, solve_friction, ContactConstraint, SolverBody};
 use carom_collision::math::Real;
 
 /// [`solve_soft`](super::solve_soft) applying every row to the bodies (the form before
@@ -29,4 +29,3 @@ pub(crate) fn solve_soft_rows(
         p.max_normal_impulse = p.max_normal_impulse.max(new);
     }
 }
-
