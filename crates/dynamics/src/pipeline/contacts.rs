@@ -66,7 +66,12 @@ impl World {
             let (Some(ba), Some(bb)) = (body(pc.a), body(pc.b)) else {
                 continue;
             };
-            let (Ok(ia), Ok(ib)) = (set.slot(ba), set.slot(bb)) else {
+            // One at a time: a tuple of the two `Result`s (with their error payloads) was
+            // built on the stack for every manifold (~30 instructions of copies).
+            let Ok(ia) = set.slot(ba) else {
+                continue;
+            };
+            let Ok(ib) = set.slot(bb) else {
                 continue;
             };
             let (info_a, info_b) = (&set.info[ia], &set.info[ib]);

@@ -11,7 +11,17 @@ use super::coloring::{colour_into, ColourScratch, Colouring, PairConstraint};
 use super::{inv_or_zero, Softness, SolverBody, SolverParams};
 use crate::body_set::BodySet;
 use crate::contact::{ContactManifold, MAX_MANIFOLD_POINTS};
-use carom_collision::math::{orthonormal_basis, Real, Vec3};
+use carom_collision::math::{Real, Vec3};
+
+#[path = "contact_prepare.rs"]
+mod prep;
+pub(crate) use prep::{ConstraintSink, PreparedHead, PreparedPoint, Preparer};
+
+#[cfg(test)]
+#[path = "contact_tests.rs"]
+mod tests;
+#[cfg(test)]
+pub(crate) use tests::solve_soft_rows;
 
 /// One Jacobian row of a contact point along a unit direction `d` (the normal or a tangent):
 /// the angular parts `r_a × d`, `r_b × d` and the same premultiplied by the inverse world
@@ -194,49 +204,6 @@ impl ContactScratch {
     }
 }
 
-/// What preparing one constraint reads: the step's manifolds and bodies, the selection and
-/// its colour order, the warm-start factor and the softness pair. [`Preparer::make`] is the
-/// one routine behind the serial build in [`prepare`] and the soft step's prepare stages
-/// (module `soft_stages`), so both give the same bits.
-#[derive(Clone, Copy)]
-pub(crate) struct Preparer<'a> {
-    /// The step's manifolds.
-    pub manifolds: &'a [ContactManifold],
-    /// Manifold index of each selected manifold ([`ContactScratch::selected`]).
-    pub selected: &'a [usize],
-    /// The colour order (`Colouring::order`): position `k` holds a selection index.
-    pub order: &'a [usize],
-    /// The body set (poses and centres of mass).
-    pub set: &'a BodySet,
-    /// The solver bodies.
-    pub bodies: &'a [SolverBody],
-    /// Factor of the stored impulses (per-step units to the solver's; 0: no warm start).
-    pub impulse_in: Real,
-    /// Softness between two dynamic bodies and against a non-dynamic one.
-    pub soft: (Softness, Softness),
-}
-
-impl Preparer<'_> {
-    /// Prepares the constraint at position `k` of the colour order into `out` (its Jacobian
-    /// rows only when `rows`), as [`prepare_one`] does.
-    #[inline]
-    pub(crate) fn make(&self, k: usize, out: &mut ContactConstraint, rows: bool) {
-        let m_index = self.selected[self.order[k]];
-        let m = &self.manifolds[m_index];
-        let (set, bodies) = (self.set, self.bodies);
-        prepare_one(
-            out,
-            m,
-            m_index,
-            set,
-            bodies,
-            self.impulse_in,
-            self.soft,
-            rows,
-        );
-    }
-}
-
 /// Selects the manifolds that touch an awake dynamic body and colours them (module
 /// `coloring`), with the colour ranges in `scratch.colouring.ranges`, and builds their
 /// constraints in colour order. Scalar (`simd` false): all of them into `scratch.cons`.
@@ -315,93 +282,6 @@ pub(crate) fn prepare(
             c
         }));
     }
-}
-
-/// Writes the constraint of manifold `m` (index `m_index`), which touches an awake dynamic
-/// body, into `out`: every field and the points `..len`; the points from `len` on are left
-/// as they were (nothing reads them), so a reused `out` is neither zeroed nor copied.
-/// `(soft, static_soft)` are the softness between two dynamic bodies and against a
-/// non-dynamic one. Without `rows` the Jacobian rows are left stale: the SIMD build
-/// computes them four constraints at a time from the lever arms
-/// (`contact_simd::WideConstraint::finish`), with the same arithmetic as [`ContactRow::new`].
-#[allow(clippy::too_many_arguments)]
-fn prepare_one(
-    out: &mut ContactConstraint,
-    m: &ContactManifold,
-    m_index: usize,
-    set: &BodySet,
-    bodies: &[SolverBody],
-    impulse_in: Real,
-    (soft, static_soft): (Softness, Softness),
-    rows: bool,
-) {
-    let (a, b) = (m.body_a.index as usize, m.body_b.index as usize);
-    let (ba, bb) = (&bodies[a], &bodies[b]);
-    let (pose_a, pose_b) = (set.pose_of(a), set.pose_of(b));
-    let (com_a, com_b) = (set.position[a], set.position[b]);
-    let n = m.normal.normalize();
-    let len = m.points().len();
-    let mut arms = [(Vec3::ZERO, Vec3::ZERO); MAX_MANIFOLD_POINTS];
-    let mut centre_velocity = Vec3::ZERO;
-    for ((p, pt), arm) in m.points().iter().zip(&mut out.points).zip(&mut arms) {
-        let c = 0.5 * (pose_a.transform_point(p.local_a) + pose_b.transform_point(p.local_b));
-        let (ra, rb) = (c - com_a, c - com_b);
-        *arm = (ra, rb);
-        let dv = bb.point_velocity(rb) - ba.point_velocity(ra);
-        centre_velocity += dv;
-        if rows {
-            pt.normal_row = ContactRow::new(ba, bb, ra, rb, n);
-        }
-        pt.arm_a = ra;
-        pt.arm_b = rb;
-        pt.separation = p.separation;
-        pt.relative_velocity = dv.dot(n);
-        pt.normal_impulse = p.normal_impulse * impulse_in;
-        pt.tangent_impulse = [
-            p.tangent_impulse[0] * impulse_in,
-            p.tangent_impulse[1] * impulse_in,
-        ];
-        pt.push_impulse = 0.0;
-        pt.max_normal_impulse = 0.0;
-    }
-    let t1 = friction_direction(m.tangent, n, centre_velocity / len as Real);
-    let t2 = n.cross(t1);
-    if rows {
-        for (pt, &(ra, rb)) in out.points[..len].iter_mut().zip(&arms) {
-            pt.tangent_rows = [
-                ContactRow::new(ba, bb, ra, rb, t1),
-                ContactRow::new(ba, bb, ra, rb, t2),
-            ];
-        }
-    }
-    out.a = a;
-    out.b = b;
-    out.manifold = m_index;
-    out.normal = n;
-    out.tangent = [t1, t2];
-    out.friction = m.friction;
-    out.restitution = m.restitution;
-    out.softness = if ba.dynamic && bb.dynamic {
-        soft
-    } else {
-        static_soft
-    };
-    out.len = len;
-}
-
-/// The first friction direction: the cached one if still roughly in the tangent plane
-/// (direction caching keeps warm-started friction meaningful), else the sliding direction,
-/// else a fixed basis vector of the normal.
-fn friction_direction(cached: Vec3, n: Vec3, relative_velocity: Vec3) -> Vec3 {
-    let c = cached - n * n.dot(cached);
-    if c.length_squared() > 0.25 {
-        return c.normalize();
-    }
-    let vt = relative_velocity - n * n.dot(relative_velocity);
-    if vt.length_squared() > 1e-6 {
-        return vt.normalize();
-    }
-    orthonormal_basis(n).0
 }
 
 /// Applies the accumulated impulses (warm start).
@@ -635,32 +515,6 @@ fn soft_terms(
         )
     } else {
         (0.0, 1.0, 0.0)
-    }
-}
-
-/// [`solve_soft`] applying every row to the bodies (the form before [`FrameVelocity`]): the
-/// oracle of the frame form's test.
-#[cfg(test)]
-pub(crate) fn solve_soft_rows(
-    c: &mut ContactConstraint,
-    a: &mut SolverBody,
-    b: &mut SolverBody,
-    inv_h: Real,
-    max_push: Real,
-    use_bias: bool,
-) {
-    solve_friction(c, a, b);
-    let (linear, soft) = (c.normal.dot(b.dp - a.dp), c.softness);
-    for p in c.points[..c.len].iter_mut() {
-        let row = &p.normal_row;
-        let s = p.separation + row.displacement(linear, a, b);
-        let (bias, mass_scale, impulse_scale) = soft_terms(soft, s, inv_h, max_push, use_bias);
-        let vn = row.velocity(c.normal, a, b);
-        let lambda = -row.mass * mass_scale * (vn + bias) - impulse_scale * p.normal_impulse;
-        let new = (p.normal_impulse + lambda).max(0.0);
-        row.apply(c.normal, new - p.normal_impulse, a, b);
-        p.normal_impulse = new;
-        p.max_normal_impulse = p.max_normal_impulse.max(new);
     }
 }
 

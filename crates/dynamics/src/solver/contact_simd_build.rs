@@ -10,7 +10,9 @@
 
 use super::{WideConstraint, WidePoint, WideRow, WideScratch, LANES, NONE, NO_SLOT, V3, W};
 use crate::contact::{ContactManifold, MAX_MANIFOLD_POINTS};
-use crate::solver::contact::{ContactConstraint, PointConstraint};
+use crate::solver::contact::{
+    ConstraintSink, ContactConstraint, PointConstraint, PreparedHead, PreparedPoint, Preparer,
+};
 use crate::solver::SolverBody;
 use carom_collision::math::{Mat3, Real, Vec3};
 use std::ops::Range;
@@ -52,7 +54,7 @@ fn get3(v: &V3, l: usize) -> Vec3 {
 /// that form and consumed by [`WideConstraint::finish`]. (The lever arms go straight into
 /// the points, which keep them.)
 #[derive(Default)]
-pub(super) struct RowInputs {
+pub(crate) struct RowInputs {
     inv_i_a: [[W; 3]; 3],
     inv_i_b: [[W; 3]; 3],
 }
@@ -247,7 +249,7 @@ pub(crate) fn fill(
     make: impl Fn(usize, &mut ContactConstraint, bool),
 ) {
     assign(out, ranges, points);
-    build_range(&mut out.cons, &out.members, bodies, &make);
+    build_range(&mut out.cons, &out.members, bodies, &ViaScalar(&make));
     cons.clear();
     if let Some(overflow) = ranges.last() {
         cons.extend(overflow.clone().map(|k| {
@@ -313,18 +315,119 @@ pub(crate) fn assign(
     out.cons.truncate(used);
 }
 
+/// Where [`build_range`] gets the constraint of each lane from.
+pub(crate) trait LaneSource {
+    /// Writes the constraint at position `k` of the colour order into lane `l` of `w`, as
+    /// [`WideConstraint::set_lane`] writes a prepared one (the inverse inertias into
+    /// `inputs`), and returns its point count.
+    fn lane(
+        &self,
+        k: usize,
+        w: &mut WideConstraint,
+        l: usize,
+        bodies: &[SolverBody],
+        inputs: &mut RowInputs,
+    ) -> usize;
+}
+
+/// A [`LaneSource`] that prepares each constraint into a scalar [`ContactConstraint`] with
+/// `make(k, c, false)` and copies it into its lane ([`WideConstraint::set_lane`]): the
+/// tests' route, and the oracle of the direct one ([`Preparer`] as a [`LaneSource`]).
+#[cfg(test)]
+pub(crate) struct ViaScalar<F>(pub F);
+
+#[cfg(test)]
+impl<F: Fn(usize, &mut ContactConstraint, bool)> LaneSource for ViaScalar<F> {
+    fn lane(
+        &self,
+        k: usize,
+        w: &mut WideConstraint,
+        l: usize,
+        bodies: &[SolverBody],
+        inputs: &mut RowInputs,
+    ) -> usize {
+        let mut c = ContactConstraint::EMPTY;
+        (self.0)(k, &mut c, false);
+        w.set_lane(l, Some(&c), bodies, inputs);
+        c.len
+    }
+}
+
+/// A [`ConstraintSink`] writing one prepared constraint straight into lane `l` of a wide
+/// constraint: the values [`WideConstraint::set_lane`] would copy from the scalar
+/// constraint, without building it.
+struct LaneSink<'a> {
+    w: &'a mut WideConstraint,
+    l: usize,
+    inputs: &'a mut RowInputs,
+}
+
+impl ConstraintSink for LaneSink<'_> {
+    #[inline(always)]
+    fn point(&mut self, k: usize, p: &PreparedPoint, _: &SolverBody, _: &SolverBody, _: Vec3) {
+        let (l, wp) = (self.l, &mut self.w.points[k]);
+        put3(&mut wp.arm_a, l, p.arm_a);
+        put3(&mut wp.arm_b, l, p.arm_b);
+        put(&mut wp.separation, l, p.separation);
+        put(&mut wp.normal_impulse, l, p.normal_impulse);
+        put(&mut wp.tangent_impulse[0], l, p.tangent_impulse[0]);
+        put(&mut wp.tangent_impulse[1], l, p.tangent_impulse[1]);
+        put(&mut wp.max_normal_impulse, l, 0.0);
+        put(&mut self.w.relative_velocity[k], l, p.relative_velocity);
+    }
+
+    #[inline(always)]
+    fn head(&mut self, h: &PreparedHead, a: &SolverBody, b: &SolverBody) {
+        let (l, w) = (self.l, &mut *self.w);
+        w.a[l] = lane_index(h.a);
+        w.b[l] = lane_index(h.b);
+        w.write_a[l] = a.dynamic;
+        w.write_b[l] = b.dynamic;
+        w.manifold[l] = lane_index(h.manifold);
+        w.lens[l] = h.len as u32;
+        put(&mut w.inv_m_a, l, a.inv_m);
+        put(&mut w.inv_m_b, l, b.inv_m);
+        put_mat(&mut self.inputs.inv_i_a, l, &a.inv_i);
+        put_mat(&mut self.inputs.inv_i_b, l, &b.inv_i);
+        put3(&mut w.normal, l, h.normal);
+        put3(&mut w.tangent, l, h.tangent[0]);
+        put(&mut w.friction, l, h.friction);
+        put(&mut w.restitution, l, h.restitution);
+        put(&mut w.bias_rate, l, h.softness.bias_rate);
+        put(&mut w.mass_scale, l, h.softness.mass_scale);
+        put(&mut w.impulse_scale, l, h.softness.impulse_scale);
+    }
+}
+
+/// The direct route: [`Preparer::make_into`] writes each constraint into its lane.
+impl LaneSource for Preparer<'_> {
+    #[inline(always)]
+    fn lane(
+        &self,
+        k: usize,
+        w: &mut WideConstraint,
+        l: usize,
+        _: &[SolverBody],
+        inputs: &mut RowInputs,
+    ) -> usize {
+        let mut sink = LaneSink { w, l, inputs };
+        self.make_into(k, &mut sink);
+        sink.w.lens[l] as usize
+    }
+}
+
 /// Builds the wide constraints `ws` whose lanes hold the constraints `ms` (their
-/// [`WideScratch::members`]): one constraint at a time is prepared (`make(k, c, false)`,
-/// without its rows) and written into its lane, then [`WideConstraint::finish`] builds the
-/// rows of the four lanes at once. Each wide constraint is written only from its own lanes,
-/// so disjoint ranges can be built on different threads with the same bits.
+/// [`WideScratch::members`]): each lane's constraint is prepared by `src` (the soft step:
+/// a [`Preparer`], written straight into the lane; tests: [`ViaScalar`]), then
+/// [`WideConstraint::finish`] builds the rows of the four lanes at once. Each wide
+/// constraint is written only from its own lanes, so disjoint ranges can be built on
+/// different threads with the same bits.
 pub(crate) fn build_range(
     ws: &mut [WideConstraint],
     ms: &[[usize; LANES]],
     bodies: &[SolverBody],
-    make: &impl Fn(usize, &mut ContactConstraint, bool),
+    src: &impl LaneSource,
 ) {
-    let mut c = ContactConstraint::EMPTY;
     let mut inputs = RowInputs::default();
     for (w, m) in ws.iter_mut().zip(ms) {
         w.len = 0;
@@ -332,9 +435,8 @@ pub(crate) fn build_range(
             if k == NONE {
                 w.set_lane(lane, None, bodies, &mut inputs);
             } else {
-                make(k, &mut c, false);
-                w.len = w.len.max(c.len);
-                w.set_lane(lane, Some(&c), bodies, &mut inputs);
+                let len = src.lane(k, w, lane, bodies, &mut inputs);
+                w.len = w.len.max(len);
             }
         }
         w.finish(&inputs);
@@ -449,3 +551,7 @@ pub(crate) fn write_back(wide: &WideScratch, cons: &mut [ContactConstraint]) {
         }
     }
 }
+
+#[cfg(test)]
+#[path = "contact_simd_build_tests.rs"]
+mod tests;

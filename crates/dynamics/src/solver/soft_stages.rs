@@ -506,8 +506,7 @@ impl Shared<'_> {
         assert!(range.end <= self.n_wide && range.end <= self.members.len());
         let p = self.preparer();
         let ws = std::slice::from_raw_parts_mut(self.wide.add(range.start), range.len());
-        let make = |k: usize, out: &mut ContactConstraint, rows: bool| p.make(k, out, rows);
-        contact_simd::build_range(ws, &self.members[range], p.bodies, &make);
+        contact_simd::build_range(ws, &self.members[range], p.bodies, &p);
     }
 
     /// Builds the scalar constraints of the overflow colour (one block).
