@@ -304,11 +304,15 @@ fn clip_box_faces_with(
     let mut bufs = [Poly::EMPTY; 2];
     // The incident face's corners in the polyhedron's loop order (outward, counter-clockwise),
     // so the points, their ids and their order are the general clipper's.
+    // The four sums `±u ± v` formed once: `(-u) + v` is `-(u - v)` and `(-u) + (-v)` is
+    // `-(u + v)` exactly (IEEE addition commutes and negation is exact), so every corner
+    // has the bits of `centre + (su + sv)` with `su = ±u`, `sv = ±v` chosen per corner.
+    let (sum, diff) = (u + v, u - v);
+    let offsets = [-sum, -diff, diff, sum]; // indexed by (u's sign bit, v's sign bit)
     for (k, &c) in BOX_LOOPS[4 * inc_face..4 * inc_face + 4].iter().enumerate() {
-        let su = if c & (1 << k1) != 0 { u } else { -u };
-        let sv = if c & (1 << k2) != 0 { v } else { -v };
+        let code = (((c >> k1) & 1) << 1 | ((c >> k2) & 1)) as usize;
         let _ = bufs[0].push(
-            (centre + (su + sv)).to_array(),
+            (centre + offsets[code]).to_array(),
             id | ((k as u32 & 0xFF) << 8),
         );
     }
@@ -326,12 +330,15 @@ fn clip_box_faces_with(
             // sequence, so the points and ids are the same bits.
             let src = &bufs[cur];
             let n = src.len;
-            let mut dist = [0.0 as Real; CLIP_CAP];
+            // One more slot: the first corner's distance again, so the edge from the last
+            // corner back to the first reads its end without an index wrap.
+            let mut dist = [0.0 as Real; CLIP_CAP + 1];
             let mut all_inside = true;
             for (d, (p, _)) in dist.iter_mut().zip(&src.pts[..n]) {
                 *d = s * p[k] - limit;
                 all_inside &= *d < 0.0;
             }
+            dist[n] = dist[0];
             if all_inside {
                 tag += 1;
                 continue;
@@ -345,14 +352,13 @@ fn clip_box_faces_with(
             dst.len = 0;
             for e in 0..n {
                 let (p, ip) = src.pts[e];
-                let next = if e + 1 == n { 0 } else { e + 1 };
-                let (dp, dq) = (dist[e], dist[next]);
+                let (dp, dq) = (dist[e], dist[e + 1]);
                 if dp <= 0.0 && !dst.push(p, ip) {
                     return;
                 }
                 if (dp < 0.0) != (dq < 0.0) && dp != dq {
                     let t = dp / (dp - dq);
-                    let q = src.pts[next].0;
+                    let q = src.pts[if e + 1 == n { 0 } else { e + 1 }].0;
                     let (pv, qv) = (Vec3::from_array(p), Vec3::from_array(q));
                     if !dst.push((pv + (qv - pv) * t).to_array(), (ip & 0xFFFF_FF00) | tag) {
                         return;
