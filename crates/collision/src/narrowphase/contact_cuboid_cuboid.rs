@@ -20,7 +20,7 @@ use super::contact::{ContactList, FeatureId};
 use super::manifold::Separation;
 use super::polyhedron::{polyhedron_manifold_guided, Polyhedron, BOX_LOOPS, EPA_FEATURE};
 use super::polyhedron_guided::witness_realises_depth;
-use crate::math::{Isometry, Mat3, Real, Vec3};
+use crate::math::{Isometry, Mat3, Real, Vec3, Vec3A};
 use crate::query::contact_cuboid_cuboid::{
     cuboid_cuboid_axis_or_separation_mat, cuboid_cuboid_witness, Axis,
 };
@@ -146,6 +146,16 @@ fn clip_face_b(
     let mut nr = Vec3::ZERO;
     nr[fb / 2] = if fb.is_multiple_of(2) { 1.0 } else { -1.0 };
     let normal = *rot * -nr;
+    // The points' two products on SIMD columns (`Vec3A`), summed in `Mat3 * Vec3`'s order
+    // (column by column, nothing fused), so the same bits as the scalar products; in f64
+    // `Vec3A` is `Vec3`.
+    let cols = [rot.x_axis, rot.y_axis, rot.z_axis].map(to_vec3a);
+    let ta = to_vec3a(t);
+    let map = |p: Vec3| {
+        let v = to_vec3a(p);
+        let r = cols[0] * v.x + cols[1] * v.y + cols[2] * v.z + ta;
+        to_vec3(r)
+    };
     clip_box_faces_with(
         hb,
         fb,
@@ -157,13 +167,27 @@ fn clip_face_b(
         |c, id| {
             let c = Contact {
                 distance: c.distance,
-                point_a: *rot * c.point_b + t,
-                point_b: *rot * c.point_a + t,
+                point_a: map(c.point_b),
+                point_b: map(c.point_a),
                 normal,
             };
             out.push((c, id))
         },
     );
+}
+
+/// A [`Vec3`] as a SIMD vector (the identity in f64, where `Vec3A` is `Vec3`).
+#[inline(always)]
+#[allow(clippy::useless_conversion)]
+fn to_vec3a(v: Vec3) -> Vec3A {
+    v.into()
+}
+
+/// A SIMD vector back to [`Vec3`] (the identity in f64).
+#[inline(always)]
+#[allow(clippy::useless_conversion)]
+fn to_vec3(v: Vec3A) -> Vec3 {
+    v.into()
 }
 
 /// Room for the corners of a box face through the four side-plane clips: a clip of a convex
