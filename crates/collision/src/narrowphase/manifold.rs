@@ -345,8 +345,11 @@ impl ContactManifold {
             new_points.retain(|p| p.is_finite());
         }
         // Reducing before matching keeps the same points as matching first: the reduction
-        // looks at positions and depths only.
-        reduce_points(new_points);
+        // looks at positions and depths only. (Most generations have at most four points:
+        // the test is made here, without the call.)
+        if new_points.len() > MAX_MANIFOLD_POINTS {
+            reduce_points(new_points);
+        }
         for p in new_points.iter_mut() {
             if let Some(i) = self.find_match(p, merge_distance) {
                 let old = &self.points[i];
