@@ -20,7 +20,7 @@ use super::contact::{ContactList, FeatureId};
 use super::manifold::Separation;
 use super::polyhedron::{polyhedron_manifold_guided, Polyhedron, BOX_LOOPS, EPA_FEATURE};
 use super::polyhedron_guided::witness_realises_depth;
-use crate::math::{Isometry, Mat3, Real, Vec3};
+use crate::math::{Isometry, Mat3, Real, Vec3, Vec3A};
 use crate::query::contact_cuboid_cuboid::{
     cuboid_cuboid_axis_or_separation_mat, cuboid_cuboid_witness, Axis,
 };
@@ -146,6 +146,16 @@ fn clip_face_b(
     let mut nr = Vec3::ZERO;
     nr[fb / 2] = if fb.is_multiple_of(2) { 1.0 } else { -1.0 };
     let normal = *rot * -nr;
+    // The points' two products on SIMD columns (`Vec3A`), summed in `Mat3 * Vec3`'s order
+    // (column by column, nothing fused), so the same bits as the scalar products; in f64
+    // `Vec3A` is `Vec3`.
+    let cols = [rot.x_axis, rot.y_axis, rot.z_axis].map(to_vec3a);
+    let ta = to_vec3a(t);
+    let map = |p: Vec3| {
+        let v = to_vec3a(p);
+        let r = cols[0] * v.x + cols[1] * v.y + cols[2] * v.z + ta;
+        to_vec3(r)
+    };
     clip_box_faces_with(
         hb,
         fb,
@@ -157,13 +167,27 @@ fn clip_face_b(
         |c, id| {
             let c = Contact {
                 distance: c.distance,
-                point_a: *rot * c.point_b + t,
-                point_b: *rot * c.point_a + t,
+                point_a: map(c.point_b),
+                point_b: map(c.point_a),
                 normal,
             };
             out.push((c, id))
         },
     );
+}
+
+/// A [`Vec3`] as a SIMD vector (the identity in f64, where `Vec3A` is `Vec3`).
+#[inline(always)]
+#[allow(clippy::useless_conversion)]
+fn to_vec3a(v: Vec3) -> Vec3A {
+    v.into()
+}
+
+/// A SIMD vector back to [`Vec3`] (the identity in f64).
+#[inline(always)]
+#[allow(clippy::useless_conversion)]
+fn to_vec3(v: Vec3A) -> Vec3 {
+    v.into()
 }
 
 /// Room for the corners of a box face through the four side-plane clips: a clip of a convex
@@ -304,11 +328,15 @@ fn clip_box_faces_with(
     let mut bufs = [Poly::EMPTY; 2];
     // The incident face's corners in the polyhedron's loop order (outward, counter-clockwise),
     // so the points, their ids and their order are the general clipper's.
+    // The four sums `±u ± v` formed once: `(-u) + v` is `-(u - v)` and `(-u) + (-v)` is
+    // `-(u + v)` exactly (IEEE addition commutes and negation is exact), so every corner
+    // has the bits of `centre + (su + sv)` with `su = ±u`, `sv = ±v` chosen per corner.
+    let (sum, diff) = (u + v, u - v);
+    let offsets = [-sum, -diff, diff, sum]; // indexed by (u's sign bit, v's sign bit)
     for (k, &c) in BOX_LOOPS[4 * inc_face..4 * inc_face + 4].iter().enumerate() {
-        let su = if c & (1 << k1) != 0 { u } else { -u };
-        let sv = if c & (1 << k2) != 0 { v } else { -v };
+        let code = (((c >> k1) & 1) << 1 | ((c >> k2) & 1)) as usize;
         let _ = bufs[0].push(
-            (centre + (su + sv)).to_array(),
+            (centre + offsets[code]).to_array(),
             id | ((k as u32 & 0xFF) << 8),
         );
     }
@@ -326,12 +354,15 @@ fn clip_box_faces_with(
             // sequence, so the points and ids are the same bits.
             let src = &bufs[cur];
             let n = src.len;
-            let mut dist = [0.0 as Real; CLIP_CAP];
+            // One more slot: the first corner's distance again, so the edge from the last
+            // corner back to the first reads its end without an index wrap.
+            let mut dist = [0.0 as Real; CLIP_CAP + 1];
             let mut all_inside = true;
             for (d, (p, _)) in dist.iter_mut().zip(&src.pts[..n]) {
                 *d = s * p[k] - limit;
                 all_inside &= *d < 0.0;
             }
+            dist[n] = dist[0];
             if all_inside {
                 tag += 1;
                 continue;
@@ -345,14 +376,13 @@ fn clip_box_faces_with(
             dst.len = 0;
             for e in 0..n {
                 let (p, ip) = src.pts[e];
-                let next = if e + 1 == n { 0 } else { e + 1 };
-                let (dp, dq) = (dist[e], dist[next]);
+                let (dp, dq) = (dist[e], dist[e + 1]);
                 if dp <= 0.0 && !dst.push(p, ip) {
                     return;
                 }
                 if (dp < 0.0) != (dq < 0.0) && dp != dq {
                     let t = dp / (dp - dq);
-                    let q = src.pts[next].0;
+                    let q = src.pts[if e + 1 == n { 0 } else { e + 1 }].0;
                     let (pv, qv) = (Vec3::from_array(p), Vec3::from_array(q));
                     if !dst.push((pv + (qv - pv) * t).to_array(), (ip & 0xFFFF_FF00) | tag) {
                         return;

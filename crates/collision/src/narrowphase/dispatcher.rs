@@ -22,7 +22,7 @@ use super::polyhedron::{
 use super::polyhedron_guided::hull_manifold_or_separation;
 use super::triangle_cuboid::triangle_cuboid_manifold_into;
 use crate::error::{CaromError, Result};
-use crate::math::{Isometry, Real};
+use crate::math::{Isometry, Mat3, Real, Vec3, Vec3A};
 use crate::query::contact::{contact_convex_plane, contact_plane_convex};
 use crate::query::{contact_convex, Contact};
 use crate::shape::{ConvexRef, Plane, Shape, ShapeKind, Triangle};
@@ -551,13 +551,9 @@ impl Dispatcher {
             contacts.clear();
             pts.clear();
             // A hull pair's last normal (world, from B towards A) or separating axis seeds
-            // GJK (read before the certificate is cleared).
-            let hint = match (manifold.points.first(), &manifold.apart) {
-                (Some(p), _) => Some(-pose_a.inverse_transform_vector(p.normal)),
-                (None, Some(s)) => Some(s.axis),
-                (None, None) => None,
-            };
-            manifold.apart = None;
+            // GJK: the certificate is taken before it is cleared, the hint formed only on the
+            // hull path (a quaternion rotation per box pair before).
+            let apart = manifold.apart.take();
             let full = match (a, b) {
                 // Box–box directly (the built-in table's choice), keeping the separating axis
                 // of an apart pair as the manifold's certificate.
@@ -576,6 +572,11 @@ impl Dispatcher {
                 | (Shape::Cuboid(_), Shape::ConvexHull(_))
                     if self.user.is_empty() =>
                 {
+                    let hint = match (manifold.points.first(), &apart) {
+                        (Some(p), _) => Some(-pose_a.inverse_transform_vector(p.normal)),
+                        (None, Some(s)) => Some(s.axis),
+                        (None, None) => None,
+                    };
                     manifold.apart =
                         hull_manifold_or_separation(a, b, &pose_ab, cfg.prediction, hint, contacts);
                     true
@@ -587,9 +588,7 @@ impl Dispatcher {
                     mats.unwrap_or_else(|| (pose_a.rotation_matrix(), pose_b.rotation_matrix()));
                 let rb_t = rb.transpose();
                 let (ta, tb) = (pose_a.translation, pose_b.translation);
-                pts.extend(contacts.iter().map(|(c, id)| {
-                    ContactPoint::from_local_contact_mat(c, (&ra, ta), (&rb_t, tb), *id)
-                }));
+                convert_points(contacts, (&ra, ta), (&rb_t, tb), pts);
             }
             manifold.generated_at = full.then_some(pose_ab);
             if full {
@@ -604,60 +603,69 @@ impl Dispatcher {
     }
 }
 
-#[cfg(test)]
-mod polyhedral_tests {
-    use super::{as_polyhedron, is_polyhedral};
-    use crate::math::Vec3;
-    use crate::shape::{
-        Capsule, Cone, ConvexHull, ConvexRef, Cuboid, Cylinder, Scaled, Shape, Sphere, Triangle,
-    };
-    use std::sync::Arc;
-
-    /// The cheap dispatch guard agrees with building the view, for every kind of convex
-    /// (including a degenerate triangle, whose view still exists).
-    #[test]
-    fn is_polyhedral_matches_as_polyhedron() {
-        let sphere = Sphere::new(0.5).unwrap();
-        let cuboid = Cuboid::new(Vec3::new(0.3, 0.4, 0.5)).unwrap();
-        let capsule = Capsule::new(0.2, 0.6).unwrap();
-        let cylinder = Cylinder::new(0.3, 0.7).unwrap();
-        let cone = Cone::new(0.3, 0.7).unwrap();
-        let pts = [
-            Vec3::ZERO,
-            Vec3::X,
-            Vec3::Y,
-            Vec3::Z,
-            Vec3::new(1.0, 1.0, 1.0),
-        ];
-        let hull = ConvexHull::new(&pts).unwrap();
-        let tri = Triangle {
-            a: Vec3::ZERO,
-            b: Vec3::X,
-            c: Vec3::Y,
-        };
-        let flat = Triangle {
-            a: Vec3::ZERO,
-            b: Vec3::X,
-            c: Vec3::X * 2.0,
-        };
-        let scaled =
-            Scaled::new(Arc::new(Shape::Cuboid(cuboid)), Vec3::new(2.0, 1.0, 0.5)).unwrap();
-        let all = [
-            ConvexRef::Sphere(&sphere),
-            ConvexRef::Cuboid(&cuboid),
-            ConvexRef::Capsule(&capsule),
-            ConvexRef::Cylinder(&cylinder),
-            ConvexRef::Cone(&cone),
-            ConvexRef::ConvexHull(&hull),
-            ConvexRef::Triangle(&tri),
-            ConvexRef::Triangle(&flat),
-            ConvexRef::Scaled(&scaled),
-        ];
-        let mut polyhedral = 0;
-        for c in all {
-            assert_eq!(is_polyhedral(c), as_polyhedron(c).is_some(), "{c:?}");
-            polyhedral += usize::from(is_polyhedral(c));
-        }
-        assert_eq!(polyhedral, 4);
-    }
+/// A SIMD vector back to [`Vec3`] (the identity in f64, where `Vec3A` is `Vec3`).
+#[inline(always)]
+#[allow(clippy::useless_conversion)]
+fn to_vec3(v: Vec3A) -> Vec3 {
+    v.into()
 }
+
+/// A [`Vec3`] as a SIMD vector (the identity in f64).
+#[inline(always)]
+#[allow(clippy::useless_conversion)]
+fn to_vec3a(v: Vec3) -> Vec3A {
+    v.into()
+}
+
+/// Appends to `out` the contacts `contacts` (in A's frame) as [`ContactPoint`]s:
+/// [`ContactPoint::from_local_contact_mat`] for each, with the same bits, but (1) the
+/// matrix–vector products on SIMD columns (`Vec3A`), summed in `Mat3 * Vec3`'s order
+/// (column by column, nothing fused), as the manifold's refresh does, and (2) the world
+/// normal and its image in B's frame formed once per run of contacts with the same normal
+/// (bit for bit): a clipped face gives every point the reference face's normal, so two of
+/// the four products per point were repeated work. In f64 `Vec3A` is `Vec3` and this is the
+/// scalar code.
+fn convert_points(
+    contacts: &[(Contact, FeatureId)],
+    (ra, ta): (&Mat3, Vec3),
+    (rb_t, tb): (&Mat3, Vec3),
+    out: &mut Vec<ContactPoint>,
+) {
+    let cols = |m: &Mat3| [m.x_axis, m.y_axis, m.z_axis].map(to_vec3a);
+    let (ca, cb) = (cols(ra), cols(rb_t));
+    let mul = |m: &[Vec3A; 3], v: Vec3A| m[0] * v.x + m[1] * v.y + m[2] * v.z;
+    let (ta, tb) = (to_vec3a(ta), to_vec3a(tb));
+    let bits = |v: Vec3| v.to_array().map(Real::to_bits);
+    // The last contact normal's bits, its world normal and that normal in B's frame.
+    let mut last: Option<(_, Vec3A, Vec3A)> = None;
+    // `extend` over the mapped slice reserves once (a `push` per point checked the capacity).
+    out.extend(contacts.iter().map(|(c, id)| {
+        let point_b = mul(&ca, to_vec3a(c.point_b)) + ta;
+        let key = bits(c.normal);
+        let (normal, local_normal_b) = match last {
+            Some((k, n, ln)) if k == key => (n, ln),
+            _ => {
+                let n = -mul(&ca, to_vec3a(c.normal));
+                let ln = mul(&cb, n);
+                last = Some((key, n, ln));
+                (n, ln)
+            }
+        };
+        ContactPoint {
+            distance: c.distance,
+            normal: to_vec3(normal),
+            point_b: to_vec3(point_b),
+            local_a: c.point_a,
+            local_b: to_vec3(mul(&cb, point_b - tb)),
+            local_normal_b: to_vec3(local_normal_b),
+            feature: *id,
+            normal_impulse: 0.0,
+            tangent_impulse: [0.0; 2],
+            lifetime: 0,
+        }
+    }));
+}
+
+#[cfg(test)]
+#[path = "dispatcher_tests.rs"]
+mod tests;

@@ -339,10 +339,17 @@ impl ContactManifold {
     /// own buffer (sized for [`MAX_MANIFOLD_POINTS`] once) and left empty for reuse. (Swapping
     /// the two buffers instead handed small or empty buffers around, which then grew again.)
     pub fn replace_with(&mut self, new_points: &mut Vec<ContactPoint>, merge_distance: Real) {
-        new_points.retain(|p| p.is_finite());
+        // The usual case, every point finite, is told by one cheap test per point (see
+        // `finite_point`); `retain` runs only when one is not.
+        if !new_points.iter().all(finite_point) {
+            new_points.retain(|p| p.is_finite());
+        }
         // Reducing before matching keeps the same points as matching first: the reduction
-        // looks at positions and depths only.
-        reduce_points(new_points);
+        // looks at positions and depths only. (Most generations have at most four points:
+        // the test is made here, without the call.)
+        if new_points.len() > MAX_MANIFOLD_POINTS {
+            reduce_points(new_points);
+        }
         for p in new_points.iter_mut() {
             if let Some(i) = self.find_match(p, merge_distance) {
                 let old = &self.points[i];
@@ -373,6 +380,24 @@ impl ContactManifold {
 #[allow(clippy::useless_conversion)]
 fn to_vec3(v: Vec3A) -> Vec3 {
     v.into()
+}
+
+/// A [`Vec3`] as a SIMD vector (the identity in f64).
+#[inline(always)]
+#[allow(clippy::useless_conversion)]
+fn to_vec3a(v: Vec3) -> Vec3A {
+    v.into()
+}
+
+/// [`ContactPoint::is_finite`] without a branch per value: `x · 0` is `±0` for a finite `x`
+/// and NaN for an infinity or a NaN, and a sum of `±0`s is `±0` while a sum with a NaN is
+/// NaN, so the sum of the thirteen values times zero is zero exactly when all are finite.
+/// The vectors' products and sums run on SIMD lanes (`Vec3A`; plain `Vec3` in f64).
+#[inline]
+fn finite_point(p: &ContactPoint) -> bool {
+    let z = |v: Vec3| to_vec3a(v) * 0.0;
+    let sum = z(p.normal) + z(p.point_b) + z(p.local_a) + z(p.local_b);
+    sum.cmpeq(Vec3A::ZERO).all() && p.distance * 0.0 == 0.0
 }
 
 /// [`ContactManifold::reduce`] on a list of points, in place.
@@ -448,6 +473,61 @@ fn reduce_points(points: &mut Vec<ContactPoint>) {
 mod tests {
     use super::*;
     use crate::math::Quat;
+
+    /// The branch-free finiteness test agrees with `ContactPoint::is_finite` on every
+    /// field holding a finite value, zero of either sign, the largest finite value, an
+    /// infinity or a NaN.
+    #[test]
+    fn finite_point_matches_is_finite() {
+        let specials = [
+            0.0,
+            -0.0,
+            1.5,
+            -3.0e7,
+            Real::MAX,
+            Real::MIN,
+            Real::MIN_POSITIVE,
+            Real::INFINITY,
+            Real::NEG_INFINITY,
+            Real::NAN,
+        ];
+        let base = ContactPoint {
+            distance: 0.01,
+            normal: Vec3::Y,
+            point_b: Vec3::new(1.0, 2.0, 3.0),
+            local_a: Vec3::new(-1.0, 0.5, 3.0),
+            local_b: Vec3::new(0.25, -2.0, 1.0e3),
+            local_normal_b: Vec3::Z,
+            feature: 0,
+            normal_impulse: 0.0,
+            tangent_impulse: [0.0; 2],
+            lifetime: 0,
+        };
+        let (mut finite, mut not) = (0, 0);
+        for field in 0..13 {
+            for &x in &specials {
+                for &y in &specials[..4] {
+                    let mut p = base;
+                    let mut set = |i: usize, x: Real| match i {
+                        0 => p.distance = x,
+                        1..=3 => p.normal[i - 1] = x,
+                        4..=6 => p.point_b[i - 4] = x,
+                        7..=9 => p.local_a[i - 7] = x,
+                        _ => p.local_b[i - 10] = x,
+                    };
+                    set(field, x);
+                    set((field + 5) % 13, y);
+                    assert_eq!(finite_point(&p), p.is_finite(), "{field} {x} {y}");
+                    if p.is_finite() {
+                        finite += 1;
+                    } else {
+                        not += 1;
+                    }
+                }
+            }
+        }
+        assert!(finite > 100 && not > 100, "{finite} {not}");
+    }
 
     /// `is_coherent` as it was, forming the chord and the reach before the bound whatever
     /// the translation: the oracle of the early exit on the translation alone.
