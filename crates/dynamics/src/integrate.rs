@@ -265,13 +265,23 @@ fn gyroscopic_implicit(q: Quat, inertia: Mat3, w: Vec3, h: Real) -> Vec3 {
     let wb = q.inverse() * w;
     let iwb = inertia * wb;
     let f = wb.cross(iwb) * h;
-    let jac = inertia + (skew(wb) * inertia - skew(iwb)) * h;
+    let jac = inertia + (skew_mul(wb, inertia) - skew(iwb)) * h;
     let det = jac.determinant().abs();
     if det.is_nan() || det <= Real::EPSILON {
         return w;
     }
     let wb_new = wb - jac.inverse() * f;
     q * wb_new
+}
+
+/// `skew(w) * m` as three cross products `w × mᵢ` of `m`'s columns: 18 operations instead
+/// of the 45 of a matrix product with the skew matrix's zeros. The same values bit for bit:
+/// each component of the product is `(0·a + (−w_k)·b) + w_j·c`, the cross product's
+/// `w_j·c − b·w_k` (the zero term adds exactly, subtraction is adding the negation); only
+/// the sign of an exactly zero component may differ.
+#[inline]
+fn skew_mul(w: Vec3, m: Mat3) -> Mat3 {
+    Mat3::from_cols(w.cross(m.x_axis), w.cross(m.y_axis), w.cross(m.z_axis))
 }
 
 /// Clamps a body's speeds to its limits.
@@ -549,5 +559,40 @@ mod tests {
         prepare_terms(&set, &bodies, Vec3::ZERO, 0.01, true, &mut terms);
         let flags: Vec<bool> = terms.iter().map(|t| t.flags & GYROSCOPIC != 0).collect();
         assert_eq!(flags, [false, true]);
+    }
+
+    #[test]
+    fn skew_mul_is_the_skew_matrix_product_bit_for_bit() {
+        // The oracle is the matrix product it replaces; random, huge, tiny and far-apart
+        // magnitudes, zero components and zero columns (signs of zero aside, compared by
+        // value: `0.0 == -0.0`).
+        let mut s = 0x2545_F491_4F6C_DD1D_u64;
+        let mut next = || {
+            s = s
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            ((s >> 11) as f64 / (1u64 << 53) as f64) as Real * 2.0 - 1.0
+        };
+        let mut vecs = vec![Vec3::ZERO, Vec3::X, Vec3::new(0.0, 1.0e-30, -3.0e20)];
+        for k in 0..200 {
+            let scale = [1.0, 1.0e-6, 1.0e6, 1.0e15][k % 4];
+            let mut v = Vec3::new(next(), next(), next()) * scale;
+            if k % 5 == 0 {
+                v[k % 3] = 0.0;
+            }
+            vecs.push(v);
+        }
+        for (i, &w) in vecs.iter().enumerate() {
+            let m = Mat3::from_cols(vecs[(i + 1) % vecs.len()], vecs[(i + 7) % vecs.len()], {
+                let c = vecs[(i + 13) % vecs.len()];
+                if i % 3 == 0 {
+                    Vec3::ZERO
+                } else {
+                    c
+                }
+            });
+            let (fast, full) = (skew_mul(w, m), skew(w) * m);
+            assert_eq!(fast.to_cols_array(), full.to_cols_array(), "{w:?} {m:?}");
+        }
     }
 }

@@ -400,6 +400,23 @@ fn finite_point(p: &ContactPoint) -> bool {
     sum.cmpeq(Vec3A::ZERO).all() && p.distance * 0.0 == 0.0
 }
 
+/// The first `i < len` with the largest `f(i)` (0 when every value is `-inf` or NaN).
+/// Generic, so that each criterion of [`reduce_points`] is inlined into its loop (a `&dyn
+/// Fn` made every point an indirect call).
+#[inline]
+fn argmax(len: usize, f: impl Fn(usize) -> Real) -> usize {
+    let mut best = 0;
+    let mut best_v = Real::NEG_INFINITY;
+    for i in 0..len {
+        let v = f(i);
+        if v > best_v {
+            best_v = v;
+            best = i;
+        }
+    }
+    best
+}
+
 /// [`ContactManifold::reduce`] on a list of points, in place.
 fn reduce_points(points: &mut Vec<ContactPoint>) {
     let pts = &*points;
@@ -415,25 +432,14 @@ fn reduce_points(points: &mut Vec<ContactPoint>) {
     let n = pts[i0].normal;
     let proj = |v: Vec3| v - n * v.dot(n);
     let q: smallvec::SmallVec<[Vec3; 16]> = pts.iter().map(|p| proj(p.point_b)).collect();
-    let argmax = |f: &dyn Fn(usize) -> Real| -> usize {
-        let mut best = 0;
-        let mut best_v = Real::NEG_INFINITY;
-        for i in 0..q.len() {
-            let v = f(i);
-            if v > best_v {
-                best_v = v;
-                best = i;
-            }
-        }
-        best
-    };
-    let i1 = argmax(&|i| {
+    let len = q.len();
+    let i1 = argmax(len, |i| {
         if i == i0 {
             return Real::NEG_INFINITY;
         }
         (q[i] - q[i0]).length_squared()
     });
-    let i2 = argmax(&|i| {
+    let i2 = argmax(len, |i| {
         if i == i0 || i == i1 {
             return Real::NEG_INFINITY;
         }
@@ -446,7 +452,7 @@ fn reduce_points(points: &mut Vec<ContactPoint>) {
     };
     // The point most outside the triangle (i0, i1, i2): most negative signed area
     // against one of its edges.
-    let i3 = argmax(&|i| {
+    let i3 = argmax(len, |i| {
         if i == i0 || i == i1 || i == i2 {
             return Real::NEG_INFINITY;
         }

@@ -224,10 +224,20 @@ type Poly = SmallVec<[(Vec3, u32); 16]>;
 /// `n · x <= d` (`n` need not be unit: the clip is scale-invariant); new points get id
 /// `(start id & 0xFFFF_FF00) | tag`. Each corner's signed distance is computed once (not
 /// once per adjacent edge) and the wrap-around takes no division.
-fn clip(poly: &[(Vec3, u32)], n: Vec3, d: Real, tag: u32, out: &mut Poly) {
+///
+/// Returns false, leaving `out` untouched, when every corner lies strictly inside
+/// (`n · x - d < 0`): the clip would copy `poly` unchanged (no corner is dropped and no
+/// edge crosses the plane), so the caller keeps `poly` instead. A corner exactly on the
+/// plane takes the full loop, which may add a point there. An incident face well inside
+/// the reference face skips most of its side planes this way (Sutherland–Hodgman's trivial
+/// accept).
+fn clip(poly: &[(Vec3, u32)], n: Vec3, d: Real, tag: u32, out: &mut Poly) -> bool {
+    if poly.iter().all(|&(p, _)| n.dot(p) - d < 0.0) {
+        return false;
+    }
     out.clear();
     let Some(&(first, _)) = poly.first() else {
-        return;
+        return true;
     };
     let first_d = n.dot(first) - d;
     let mut dp = first_d;
@@ -246,6 +256,7 @@ fn clip(poly: &[(Vec3, u32)], n: Vec3, d: Real, tag: u32, out: &mut Poly) {
         }
         dp = dq;
     }
+    true
 }
 
 /// Clips the incident face of `inc` (at `pose_ri` in the reference frame) against the side
@@ -300,8 +311,11 @@ pub(crate) fn clip_faces(
         let side = (b - a).cross(nr);
         let [b0, b1] = &mut bufs;
         let (from, to) = if cur == 0 { (b0, b1) } else { (b1, b0) };
-        clip(from, side, side.dot(a), k as u32, to);
+        let clipped = clip(from, side, side.dot(a), k as u32, to);
         a = b;
+        if !clipped {
+            continue;
+        }
         cur = 1 - cur;
         if bufs[cur].is_empty() {
             break;
@@ -664,3 +678,7 @@ pub fn plane_polyhedron_manifold(
         })
         .collect()
 }
+
+#[cfg(test)]
+#[path = "polyhedron_clip_tests.rs"]
+mod clip_tests;
