@@ -14,6 +14,7 @@ use super::contact::{ContactList, FeatureId};
 #[cfg(test)]
 use super::mesh_hull::{posed_hull, EdgeScratch};
 use super::mesh_hull::{triangle_hull_manifold, PlacedHull};
+use super::mesh_round::RoundInMesh;
 use super::polyhedron::Polyhedron;
 use crate::math::Aabb;
 use crate::math::{Isometry, Real, Vec3};
@@ -422,7 +423,11 @@ fn correct_internal_edge_with(
 
 /// Contacts of triangles A (a mesh or heightfield) against convex B at `pose_ab` (A's frame,
 /// query convention), appended to `out`. `tri_contacts` appends the contacts of one
-/// triangle against B; each is then corrected for internal edges.
+/// triangle against B; each is then corrected for internal edges. A sphere or capsule B
+/// is placed in the mesh's frame once and takes closed-form triangle contacts there (the
+/// contacts of the dispatcher's triangle–sphere and triangle–capsule paths, up to
+/// round-off; see `mesh_round.rs`): `tri_contacts` then runs only for the capsule cases the
+/// closed form leaves undecided (segment through the triangle, sliver triangles).
 pub fn mesh_convex_contacts<M: ContactTriangles + ?Sized>(
     mesh: &M,
     b: ConvexRef<'_>,
@@ -433,11 +438,22 @@ pub fn mesh_convex_contacts<M: ContactTriangles + ?Sized>(
 ) {
     let aabb = convex_aabb(b, pose_ab).expanded(prediction.max(0.0));
     let slab = PlaneSlab::new(b, pose_ab);
-    contacts_in_box(mesh, b, pose_ab, prediction, &aabb, slab, tri_contacts, out);
+    let round = RoundInMesh::new(b, pose_ab);
+    contacts_in_box(
+        mesh,
+        b,
+        pose_ab,
+        prediction,
+        &aabb,
+        slab,
+        round,
+        tri_contacts,
+        out,
+    );
 }
 
 /// [`mesh_convex_contacts`] with B's box (mesh frame, expanded by the prediction) and
-/// plane cull (if any) given.
+/// plane cull (if any) and closed-form round shape (if any) given.
 #[allow(clippy::too_many_arguments)]
 fn contacts_in_box<M: ContactTriangles + ?Sized>(
     mesh: &M,
@@ -446,6 +462,7 @@ fn contacts_in_box<M: ContactTriangles + ?Sized>(
     prediction: Real,
     aabb: &Aabb,
     slab: Option<PlaneSlab>,
+    round: Option<RoundInMesh>,
     tri_contacts: &mut dyn FnMut(&Triangle, &mut ContactList),
     out: &mut ContactList,
 ) {
@@ -466,7 +483,9 @@ fn contacts_in_box<M: ContactTriangles + ?Sized>(
             continue;
         }
         let start = out.len();
-        tri_contacts(&tri, out);
+        if !round.is_some_and(|rd| rd.triangle_contacts([p, q, r], n, prediction, out)) {
+            tri_contacts(&tri, out);
+        }
         if out.len() == start {
             continue;
         }
@@ -541,6 +560,7 @@ pub fn mesh_hull_contacts<M: ContactTriangles + ?Sized>(
             prediction,
             &aabb,
             Some(slab),
+            None,
             &mut tri_contacts,
             out,
         );

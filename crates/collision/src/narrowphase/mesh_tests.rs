@@ -1,8 +1,10 @@
 //! The plane cull of `mesh_convex_contacts` against GJK/EPA distances: a culled triangle is
-//! always farther than the prediction from the shape.
+//! always farther than the prediction from the shape; the mesh query cache against the BVH
+//! and brute force; the round shapes' closed form against the general path.
 
 use super::*;
 use crate::math::{consts::PI, Quat};
+use crate::query::closest_points::closest_point_triangle;
 use crate::query::distance_convex;
 use crate::shape::{Capsule, Cuboid, Sphere};
 
@@ -299,4 +301,162 @@ fn cached_mesh_queries_follow_moved_vertices_and_clones() {
     let back: TriMesh = postcard::from_bytes(&bytes).unwrap();
     assert_eq!(back, copy);
     assert_eq!(cached(&back, &aabb), before);
+}
+
+/// The general path's contacts of triangle `tri` (A) against `b`: what `RoundInMesh`
+/// replaces.
+fn general_contacts(tri: &Triangle, b: ConvexRef<'_>, pose: &Isometry, pred: Real) -> ContactList {
+    let cfg = crate::narrowphase::ManifoldConfig {
+        prediction: pred,
+        ..Default::default()
+    };
+    let mut out = ContactList::new();
+    crate::narrowphase::dispatcher::convex_convex_into(
+        ConvexRef::Triangle(tri),
+        b,
+        pose,
+        &cfg,
+        false,
+        &mut out,
+    );
+    out
+}
+
+#[test]
+fn round_shapes_in_the_mesh_frame_match_the_general_path() {
+    let mut rng = Rng(0x2B99_2DDF_A232_49D6);
+    let sphere = Sphere::new(0.6).unwrap();
+    let capsule = Capsule::new(0.35, 0.8).unwrap();
+    let shapes = [ConvexRef::Sphere(&sphere), ConvexRef::Capsule(&capsule)];
+    let (mut compared, mut two_point, mut undecided, mut beyond) = (0, 0, 0, 0);
+    for k in 0..12000 {
+        let b = shapes[k % 2];
+        let far = [Vec3::ZERO, Vec3::new(1.0e3, -700.0, 400.0)][(k / 2) % 2];
+        let prediction = [0.0, 0.02, 0.1][k % 3];
+        // A triangle with a random or axis normal (a capsule lying on it: coplanar segment).
+        let n = if k % 4 == 0 { Vec3::Y } else { rng.unit() };
+        let (t1, t2) = (
+            n.any_orthonormal_vector(),
+            n.cross(n.any_orthonormal_vector()),
+        );
+        let size = rng.range(0.2, 4.0);
+        let centre = far + rng.unit() * rng.range(0.0, 1.0);
+        let corner = |a: Real| centre + (t1 * a.cos() + t2 * a.sin()) * size;
+        let mut tri = Triangle {
+            a: corner(rng.range(0.0, 1.0)),
+            b: corner(rng.range(2.0, 3.0)),
+            c: corner(rng.range(4.0, 5.0)),
+        };
+        if k % 13 == 0 {
+            // A sliver (the capsule's closed form declines it).
+            tri.c = tri.a + (tri.b - tri.a) * 0.4 + n.cross(tri.b - tri.a) * 1.0e-5;
+        }
+        let Some(tn) = tri.normal() else { continue };
+        // The shape's axis: random, or parallel to the plane or to an edge.
+        let axis = match k % 5 {
+            0 => t1,
+            1 => (tri.b - tri.a).normalize(),
+            _ => rng.unit(),
+        };
+        let rot = Quat::from_rotation_arc(Vec3::Y, axis);
+        // Height of the core above (or below) the plane: touching, at the prediction,
+        // overlapping, or clear by a little.
+        let r = match b {
+            ConvexRef::Sphere(s) => s.radius(),
+            ConvexRef::Capsule(c) => c.radius(),
+            _ => unreachable!(),
+        };
+        let h = match k % 6 {
+            0 => r,
+            1 => r + prediction,
+            2 => r - rng.range(0.0, 0.2),
+            _ => r + rng.range(-0.1, 0.3),
+        } * if k % 7 == 0 { -1.0 } else { 1.0 };
+        let inplane = (t1 * rng.range(-1.5, 1.5) + t2 * rng.range(-1.5, 1.5)) * size;
+        let pose = Isometry::new(centre + inplane + tn * h, rot);
+        let round = RoundInMesh::new(b, &pose).unwrap();
+        let mut fast = ContactList::new();
+        let done = round.triangle_contacts(tri.vertices(), tn, prediction, &mut fast);
+        if !done {
+            assert!(fast.is_empty());
+            undecided += 1;
+            continue;
+        }
+        let slow = general_contacts(&tri, b, &pose, prediction);
+        let scale = 1.0 + far.length();
+        let tol = 2.0e-5 * scale;
+        // Contacts within round-off of the prediction may be present in one list only.
+        let near_edge = |c: &Contact| (c.distance - prediction).abs() <= tol;
+        for (list, other) in [(&fast, &slow), (&slow, &fast)] {
+            for (c, id) in list.iter() {
+                match other.iter().find(|(_, j)| j == id) {
+                    Some((o, _)) => {
+                        // The normal joins the core to the triangle: its round-off is the
+                        // coordinates' (a few ulps of `scale`) over the core's distance.
+                        let core = (r + c.distance).abs().max(0.05);
+                        let tol_n = 1.0e-3 + 1.0e-5 * scale / core;
+                        assert!(
+                            (c.distance - o.distance).abs() <= tol
+                                && (c.normal - o.normal).length() <= tol_n
+                                && (c.point_b - c.point_a - c.normal * c.distance).length() <= tol,
+                            "case {k}: {c:?} vs {o:?}"
+                        );
+                        // Points on the triangle and on the shape (a clipped end, ids 0
+                        // and 1, sits below its segment point, so inside a tilted capsule)
+                        // and equal; a single closest pair (id 2) is on the surface and may
+                        // slide along a segment parallel to an edge or the face.
+                        // (On a sliver, the nearest edge: the barycentric closest point
+                        // divides by a near-zero area.)
+                        let to_tri = [(tri.a, tri.b), (tri.b, tri.c), (tri.c, tri.a)]
+                            .map(|(u, v)| {
+                                (closest_point_segment(c.point_a, u, v).0 - c.point_a).length()
+                            })
+                            .into_iter()
+                            .fold(
+                                (closest_point_triangle(c.point_a, tri.a, tri.b, tri.c)
+                                    - c.point_a)
+                                    .length(),
+                                Real::min,
+                            );
+                        let (sp, sq) = (round.o + round.p, round.o + round.q);
+                        let ds = (closest_point_segment(c.point_b, sp, sq).0 - c.point_b).length();
+                        assert!(
+                            to_tri <= tol && ds <= r + tol && (*id != 2 || (ds - r).abs() <= tol),
+                            "case {k}: {c:?} not on the shapes ({to_tri} {ds} {r})"
+                        );
+                        if *id != 2 {
+                            assert!(
+                                (c.point_a - o.point_a).length() <= 1.0e-3 * scale
+                                    && (c.point_b - o.point_b).length() <= 1.0e-3 * scale,
+                                "case {k}: {c:?} vs {o:?}"
+                            );
+                        }
+                        assert!(c.distance <= prediction, "case {k}: {c:?}");
+                    }
+                    None => assert!(
+                        near_edge(c),
+                        "case {k}: only one path gives {c:?} ({fast:?} vs {slow:?})"
+                    ),
+                }
+            }
+        }
+        // The deepest contact is the true distance (GJK/EPA on the pair).
+        let truth = distance_convex(ConvexRef::Triangle(&tri), b, &pose).distance;
+        match fast.iter().map(|(c, _)| c.distance).reduce(Real::min) {
+            Some(d) => assert!(
+                (d - truth).abs() <= 1.0e-4 * scale,
+                "case {k}: {d} vs {truth}"
+            ),
+            None => {
+                assert!(truth >= prediction - tol, "case {k}: none at {truth}");
+                beyond += 1;
+            }
+        }
+        two_point += usize::from(fast.len() == 2);
+        compared += 1;
+    }
+    assert!(
+        compared > 8000 && two_point > 300 && undecided > 100 && beyond > 300,
+        "compared {compared}, two-point {two_point}, undecided {undecided}, beyond {beyond}"
+    );
 }

@@ -25,6 +25,7 @@ pub mod convex;
 pub mod dispatcher;
 pub mod mesh;
 mod mesh_hull;
+mod mesh_round;
 pub mod polyhedron;
 pub mod polyhedron_guided;
 mod polyhedron_sat;

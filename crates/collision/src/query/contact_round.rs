@@ -182,7 +182,22 @@ pub fn contact_capsule_triangle_separated(
     let m = pose_ab.rotation_matrix();
     let [t0, t1, t2] = b.vertices().map(|v| m * v + pose_ab.translation);
     let (p, q) = a.segment();
-    let r = a.radius();
+    contact_segment_triangle_separated(p, q, a.radius(), [t0, t1, t2], prediction)
+}
+
+/// [`contact_capsule_triangle_separated`] with the capsule given as its segment `p`–`q` and
+/// radius `r`, and the triangle's corners `t`, all in one frame (any frame: the narrowphase
+/// calls it in a mesh's frame, with the segment placed once for all of a pair's triangles).
+/// The contact's A is the capsule, B the triangle.
+#[inline]
+pub fn contact_segment_triangle_separated(
+    p: Vec3,
+    q: Vec3,
+    r: Real,
+    t: [Vec3; 3],
+    prediction: Real,
+) -> Option<Option<Contact>> {
+    let [t0, t1, t2] = t;
     let size = (t1 - t0)
         .length()
         .max((t2 - t1).length())
