@@ -315,3 +315,52 @@ fn registered_user_algorithm_produces_the_points_in_both_orders() {
     assert!((r.points[0].point_a() - far.translation).length() < 1e-5);
     assert!((r.points[0].normal - Vec3::Y).length() < 1e-6);
 }
+
+/// A sphere resting against the middle of a boundary edge of a lone triangle (its centre
+/// beside the triangle's plane, 45° down from the edge) touches the edge, not the face: the
+/// internal-edge correction must keep the edge normal there. (It used to compare the
+/// closest point's segment parameter with the distance tolerance, so only contacts near an
+/// edge's first vertex counted as on the edge and this one was forced to the face normal.)
+#[test]
+fn boundary_edge_keeps_its_normal_along_the_whole_edge() {
+    let v = vec![
+        Vec3::new(0.0, 0.0, -1.0),
+        Vec3::new(0.0, 0.0, 1.0),
+        Vec3::new(-2.0, 0.0, 0.0),
+    ];
+    for t in [vec![[0, 1, 2]], vec![[0, 2, 1]]] {
+        let mesh = Shape::TriMesh(TriMesh::new(v.clone(), t).unwrap());
+        let d = Dispatcher::default();
+        for z in [-0.6 as Real, -0.2, 0.0, 0.3, 0.7] {
+            for s in [
+                Shape::Sphere(Sphere::new(0.5).unwrap()),
+                Shape::Capsule(Capsule::new(0.5, 0.3).unwrap()),
+            ] {
+                // Centre 0.49 from the edge point (0, 0, z), along (1, 1, 0)/√2 or
+                // (1, -1, 0)/√2 (below the triangle, which is two-sided).
+                for sy in [1.0 as Real, -1.0] {
+                    let dir = Vec3::new(1.0, sy, 0.0).normalize();
+                    let r = 0.5 - 0.01;
+                    let pose = Isometry::new(
+                        Vec3::new(0.0, 0.0, z) + dir * r,
+                        Quat::from_rotation_x(std::f64::consts::FRAC_PI_2 as Real),
+                    );
+                    let mut m = ContactManifold::new();
+                    d.update_manifold(&mesh, &Isometry::IDENTITY, &s, &pose, &mut m)
+                        .unwrap();
+                    assert!(!m.is_empty(), "z {z} side {sy}");
+                    for p in &m.points {
+                        assert!(
+                            (-p.normal).dot(dir) > 0.999,
+                            "z {z} side {sy} shape {:?}: normal {:?}, expected {:?}",
+                            s.kind(),
+                            p.normal,
+                            -dir
+                        );
+                        assert!((p.distance + 0.01).abs() < 1e-3, "distance {}", p.distance);
+                    }
+                }
+            }
+        }
+    }
+}

@@ -394,8 +394,11 @@ fn correct_internal_edge_with(
     let v = tri.vertices();
     for k in 0..3 {
         let (p, q) = (v[k], v[(k + 1) % 3]);
-        let (_, d) = closest_point_segment(c.point_a, p, q);
-        if d > tol {
+        // `closest_point_segment` returns the closest point and its segment parameter; the
+        // test is on the distance to that point (comparing the parameter with `tol` counted
+        // only contacts near the edge's first vertex as on the edge).
+        let (on_edge, _) = closest_point_segment(c.point_a, p, q);
+        if (c.point_a - on_edge).length_squared() > tol * tol {
             continue;
         }
         let e = edges[k];
