@@ -22,7 +22,7 @@ use super::polyhedron::{polyhedron_manifold_guided, Polyhedron, BOX_LOOPS, EPA_F
 use super::polyhedron_guided::witness_realises_depth;
 use crate::math::{Isometry, Mat3, Real, Vec3, Vec3A};
 use crate::query::contact_cuboid_cuboid::{
-    cuboid_cuboid_axis_or_separation_mat, cuboid_cuboid_witness, Axis,
+    cuboid_cuboid_axis_or_separation_mat, cuboid_cuboid_witness_mat, Axis,
 };
 use crate::query::Contact;
 use crate::shape::{ConvexRef, Cuboid};
@@ -85,7 +85,7 @@ pub fn cuboid_cuboid_manifold_or_separation(
             clip_face_b(ha, hb, fb, &rot, pose_ab, prediction, out);
         }
         Axis::Edge(..) => {
-            let c = cuboid_cuboid_witness(x, y, pose_ab, overlap, n, axis);
+            let c = cuboid_cuboid_witness_mat(x, y, pose_ab, &rot, overlap, n, axis);
             // The supporting edges' closest points must realise the separation or the
             // overlap: for nearly parallel edges, or touching boxes whose edge axis is not
             // where the edges meet, they may not (the polytope oracle found a point 0.116 m

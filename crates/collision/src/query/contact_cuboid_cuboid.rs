@@ -516,8 +516,23 @@ pub fn cuboid_cuboid_witness(
     n: Vec3,
     kind: Axis,
 ) -> Contact {
+    cuboid_cuboid_witness_mat(a, b, pose_ab, &pose_ab.rotation_matrix(), depth, n, kind)
+}
+
+/// [`cuboid_cuboid_witness`] with B's rotation matrix in A's frame (`rot`, which must be
+/// `pose_ab.rotation_matrix()`) already at hand, as the box–box manifold has it. The edge
+/// case indexes arrays rather than `Vec3`s by a runtime axis (a `match` per access); the
+/// arithmetic is the same, so the same bits.
+pub(crate) fn cuboid_cuboid_witness_mat(
+    a: &Cuboid,
+    b: &Cuboid,
+    pose_ab: &Isometry,
+    rot: &Mat3,
+    depth: Real,
+    n: Vec3,
+    kind: Axis,
+) -> Contact {
     let (ha, hb) = (a.half_extents(), b.half_extents());
-    let rot = pose_ab.rotation_matrix();
     let t = pose_ab.translation;
     let bx = [rot.x_axis, rot.y_axis, rot.z_axis];
     match kind {
@@ -545,14 +560,17 @@ pub fn cuboid_cuboid_witness(
         }
         Axis::Edge(i, j) => {
             // Edge of A: the support edge along e_i in +n; edge of B along b_j in -n.
-            let mut ca = Vec3::ZERO;
+            let (ha, hb, ns) = (ha.to_array(), hb.to_array(), n.to_array());
+            let mut ca = [0.0; 3];
             for k in 0..3 {
                 if k != i {
-                    ca[k] = if n[k] < 0.0 { -ha[k] } else { ha[k] };
+                    ca[k] = if ns[k] < 0.0 { -ha[k] } else { ha[k] };
                 }
             }
-            let mut ea = Vec3::ZERO;
+            let ca = Vec3::from_array(ca);
+            let mut ea = [0.0; 3];
             ea[i] = ha[i];
+            let ea = Vec3::from_array(ea);
             let mut cb = t;
             for l in 0..3 {
                 if l != j {
