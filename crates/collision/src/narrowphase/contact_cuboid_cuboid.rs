@@ -373,24 +373,35 @@ fn clip_box_faces_with(
             } else {
                 (&hi_buf[0], &mut lo[0])
             };
-            dst.len = 0;
+            // The output length in a local (not reloaded from the buffer after each store),
+            // and the corners and distances as slices of the polygon's length, so the
+            // indexing below needs no bounds checks.
+            let (pts, dist) = (&src.pts[..n], &dist[..=n]);
+            let mut len = 0;
             for e in 0..n {
-                let (p, ip) = src.pts[e];
+                let (p, ip) = pts[e];
                 let (dp, dq) = (dist[e], dist[e + 1]);
-                if dp <= 0.0 && !dst.push(p, ip) {
-                    return;
+                if dp <= 0.0 {
+                    if len == CLIP_CAP {
+                        return;
+                    }
+                    dst.pts[len] = (p, ip);
+                    len += 1;
                 }
                 if (dp < 0.0) != (dq < 0.0) && dp != dq {
                     let t = dp / (dp - dq);
-                    let q = src.pts[if e + 1 == n { 0 } else { e + 1 }].0;
+                    let q = pts[if e + 1 == n { 0 } else { e + 1 }].0;
                     let (pv, qv) = (Vec3::from_array(p), Vec3::from_array(q));
-                    if !dst.push((pv + (qv - pv) * t).to_array(), (ip & 0xFFFF_FF00) | tag) {
+                    if len == CLIP_CAP {
                         return;
                     }
+                    dst.pts[len] = ((pv + (qv - pv) * t).to_array(), (ip & 0xFFFF_FF00) | tag);
+                    len += 1;
                 }
             }
+            dst.len = len;
             cur ^= 1;
-            if bufs[cur].len == 0 {
+            if len == 0 {
                 return;
             }
             tag += 1;
