@@ -388,7 +388,9 @@ fn clip_box_faces_with(
                     dst.pts[len] = (p, ip);
                     len += 1;
                 }
-                if (dp < 0.0) != (dq < 0.0) && dp != dq {
+                // A sign change implies `dp != dq` (equal values, and NaN against anything,
+                // compare alike with 0), the general clipper's second condition.
+                if (dp < 0.0) != (dq < 0.0) {
                     let t = dp / (dp - dq);
                     let q = pts[if e + 1 == n { 0 } else { e + 1 }].0;
                     let (pv, qv) = (Vec3::from_array(p), Vec3::from_array(q));
