@@ -438,7 +438,7 @@ pub(crate) fn cuboid_cuboid_axis_or_separation_mat(
     let mut len_e = [Vec3A::ZERO; 3];
     let mut over_m = [Vec3A::ZERO; 3];
     let mut valid = [0u32; 3];
-    let mut sep_e = 0u32;
+    let mut sep_e = [0u32; 3];
     let inf = Vec3A::splat(Real::INFINITY);
     let par = Vec3A::splat(1e3 * EPSILON);
     for j in 0..3 {
@@ -453,7 +453,7 @@ pub(crate) fn cuboid_cuboid_axis_or_separation_mat(
         let o = ((ra + rb) - d.abs()) * inv;
         let ok = !len.cmple(par);
         valid[j] = ok.bitmask() & 7;
-        sep_e |= sep(o) & valid[j];
+        sep_e[j] = sep(o) & valid[j];
         over_e[j] = o;
         over_m[j] = Vec3A::select(ok, o, inf);
         dist_e[j] = d * inv;
@@ -467,32 +467,36 @@ pub(crate) fn cuboid_cuboid_axis_or_separation_mat(
         n[i2] = v[i1];
         towards_b(Vec3::from_array(n) / len_e[j][i], dist_e[j][i])
     };
-    // The first separating edge axis in the scalar test's order (`i` major).
-    if sep_e != 0 {
-        for i in 0..3 {
-            for j in 0..3 {
-                if (sep(over_e[j]) & valid[j]) >> i & 1 != 0 {
-                    return Err((-over_e[j][i], edge_normal(i, j)));
-                }
+    // The lane masks of the three `b_j` as one 9-bit mask in the scalar test's order
+    // (`i` major: bit `3 i + j`), so its lowest bit is the first axis in that order.
+    let in_order = |m: [u32; 3]| {
+        let mut r = 0u32;
+        for (j, mj) in m.into_iter().enumerate() {
+            for i in 0..3 {
+                r |= (mj >> i & 1) << (3 * i + j);
             }
         }
+        r
+    };
+    // The first separating edge axis.
+    let first_sep = in_order(sep_e);
+    if first_sep != 0 {
+        let k = first_sep.trailing_zeros() as usize;
+        let (i, j) = (k / 3, k % 3);
+        return Err((-over_e[j][i], edge_normal(i, j)));
     }
     let [m0, m1, m2] = over_m;
     let m = m0.min(m1).min(m2).min_element();
     if m < best {
         let ms = Vec3A::splat(m);
-        let eq = [
+        let eq = in_order([
             m0.cmpeq(ms).bitmask(),
             m1.cmpeq(ms).bitmask(),
             m2.cmpeq(ms).bitmask(),
-        ];
-        for i in 0..3 {
-            for j in 0..3 {
-                if eq[j] >> i & 1 != 0 {
-                    return Ok((over_e[j][i], edge_normal(i, j), Axis::Edge(i, j)));
-                }
-            }
-        }
+        ]);
+        let k = eq.trailing_zeros() as usize;
+        let (i, j) = (k / 3, k % 3);
+        return Ok((over_e[j][i], edge_normal(i, j), Axis::Edge(i, j)));
     }
     if best_k == usize::MAX {
         return Ok((best, Vec3::ZERO, Axis::FaceA(0)));
