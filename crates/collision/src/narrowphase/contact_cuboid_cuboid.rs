@@ -22,7 +22,7 @@ use super::polyhedron::{polyhedron_manifold_guided, Polyhedron, BOX_LOOPS, EPA_F
 use super::polyhedron_guided::witness_realises_depth;
 use crate::math::{Isometry, Mat3, Real, Vec3, Vec3A};
 use crate::query::contact_cuboid_cuboid::{
-    cuboid_cuboid_axis_or_separation_mat, cuboid_cuboid_witness, Axis,
+    cuboid_cuboid_axis_or_separation_mat, cuboid_cuboid_witness_mat, Axis,
 };
 use crate::query::Contact;
 use crate::shape::{ConvexRef, Cuboid};
@@ -85,7 +85,7 @@ pub fn cuboid_cuboid_manifold_or_separation(
             clip_face_b(ha, hb, fb, &rot, pose_ab, prediction, out);
         }
         Axis::Edge(..) => {
-            let c = cuboid_cuboid_witness(x, y, pose_ab, overlap, n, axis);
+            let c = cuboid_cuboid_witness_mat(x, y, pose_ab, &rot, overlap, n, axis);
             // The supporting edges' closest points must realise the separation or the
             // overlap: for nearly parallel edges, or touching boxes whose edge axis is not
             // where the edges meet, they may not (the polytope oracle found a point 0.116 m
@@ -373,24 +373,37 @@ fn clip_box_faces_with(
             } else {
                 (&hi_buf[0], &mut lo[0])
             };
-            dst.len = 0;
+            // The output length in a local (not reloaded from the buffer after each store),
+            // and the corners and distances as slices of the polygon's length, so the
+            // indexing below needs no bounds checks.
+            let (pts, dist) = (&src.pts[..n], &dist[..=n]);
+            let mut len = 0;
             for e in 0..n {
-                let (p, ip) = src.pts[e];
+                let (p, ip) = pts[e];
                 let (dp, dq) = (dist[e], dist[e + 1]);
-                if dp <= 0.0 && !dst.push(p, ip) {
-                    return;
-                }
-                if (dp < 0.0) != (dq < 0.0) && dp != dq {
-                    let t = dp / (dp - dq);
-                    let q = src.pts[if e + 1 == n { 0 } else { e + 1 }].0;
-                    let (pv, qv) = (Vec3::from_array(p), Vec3::from_array(q));
-                    if !dst.push((pv + (qv - pv) * t).to_array(), (ip & 0xFFFF_FF00) | tag) {
+                if dp <= 0.0 {
+                    if len == CLIP_CAP {
                         return;
                     }
+                    dst.pts[len] = (p, ip);
+                    len += 1;
+                }
+                // A sign change implies `dp != dq` (equal values, and NaN against anything,
+                // compare alike with 0), the general clipper's second condition.
+                if (dp < 0.0) != (dq < 0.0) {
+                    let t = dp / (dp - dq);
+                    let q = pts[if e + 1 == n { 0 } else { e + 1 }].0;
+                    let (pv, qv) = (Vec3::from_array(p), Vec3::from_array(q));
+                    if len == CLIP_CAP {
+                        return;
+                    }
+                    dst.pts[len] = ((pv + (qv - pv) * t).to_array(), (ip & 0xFFFF_FF00) | tag);
+                    len += 1;
                 }
             }
+            dst.len = len;
             cur ^= 1;
-            if bufs[cur].len == 0 {
+            if len == 0 {
                 return;
             }
             tag += 1;

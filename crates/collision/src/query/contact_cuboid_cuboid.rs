@@ -14,7 +14,7 @@ use super::gjk::{gjk, GjkResult};
 use super::guard::guarded_separated;
 use super::result::Contact;
 use super::support_adapters::{Core, Transformed};
-use crate::math::{Isometry, Mat3, Real, Vec3, EPSILON};
+use crate::math::{Isometry, Mat3, Real, Vec3, Vec3A, Vec3Swizzles, EPSILON};
 use crate::shape::{ConvexRef, Cuboid};
 
 /// The axis of least overlap of two overlapping boxes.
@@ -356,9 +356,19 @@ pub fn cuboid_cuboid_axis_or_separation(
 /// (`pose_ab.rotation_matrix()`, bit for bit) and B's centre `t` (`pose_ab.translation`)
 /// already at hand: the box–box manifold builds the matrix once and clips with it too.
 ///
-/// The nine edge axes are written out (a macro per `(i, j)`), so their cyclic indices
-/// `(i + 1) % 3`, `(i + 2) % 3` are constants rather than a runtime remainder per axis; same
-/// axes, same order, same arithmetic, so the same bits as the loop.
+/// The projections of [`SatFrame`] three axes at a time on SIMD lanes ([`Vec3A`]): A's three
+/// face axes in one vector, B's in another, and the edge axes `e_i × b_j` of one `b_j` for
+/// the three `e_i` in a third (lane `i`; the cyclic indices `i + 1`, `i + 2` become the
+/// swizzles `yzx`, `zxy`). Each lane forms the same products and sums in the same order as
+/// the scalar projection (no fused multiply–add, IEEE square root and division), so the
+/// overlaps are the same bits. The axes are then taken in the scalar test's order: the
+/// first that separates (a lane mask, its lowest bit) or the least overlap, the first on
+/// ties (the lanes' minimum, then the first axis equal to it, which is what the scalar
+/// test's strict `<` keeps), and only that axis' unit normal is built. The face axes decide
+/// before the edge axes are projected, so a pair apart along a face axis costs only those.
+/// (Bullet's `dBoxBox2` and parry's `cuboid_cuboid_find_local_separating_edge_twoway` also
+/// test the edge axes without normalising the ones that cannot win; here every edge axis is
+/// divided by its length, three at a time, to keep the scalar test's bits.)
 #[inline]
 pub(crate) fn cuboid_cuboid_axis_or_separation_mat(
     a: &Cuboid,
@@ -367,49 +377,138 @@ pub(crate) fn cuboid_cuboid_axis_or_separation_mat(
     t: Vec3,
     prediction: Real,
 ) -> Result<(Real, Vec3, Axis), (Real, Vec3)> {
-    let f = SatFrame::with_rotation(a.half_extents(), b.half_extents(), rot, t);
-    let mut best = (Real::INFINITY, Vec3::ZERO, Axis::FaceA(0));
-    // `Err` with the separation and the unit axis (from A towards B) when the axis separates
-    // the boxes by more than the prediction; the axis is only built when it is kept.
-    macro_rules! consider {
-        ($found:expr, $axis:expr, $kind:expr) => {{
-            let (overlap, dist): (Real, Real) = $found;
-            if overlap < -prediction || overlap.is_nan() {
-                return Err((-overlap, towards_b($axis, dist)));
-            }
-            if overlap < best.0 {
-                best = (overlap, towards_b($axis, dist), $kind);
-            }
-        }};
+    let (ha, hb) = (va(a.half_extents()), va(b.half_extents()));
+    let hb_s = b.half_extents().to_array();
+    let bx = [rot.x_axis, rot.y_axis, rot.z_axis];
+    let c = bx.map(va);
+    let ac = c.map(|v| v.abs());
+    let ta = va(t);
+    let lim = Vec3A::splat(-prediction);
+    // Lanes that separate by more than the prediction, or are NaN.
+    let sep = |o: Vec3A| (o.cmplt(lim) | o.cmpne(o)).bitmask();
+    // A's face axis `i` (lane `i`): `ha[i] + Σ_j |r[j][i]| hb[j] - |t[i]|`.
+    let over_a = (ha + (ac[0] * hb.x + ac[1] * hb.y + ac[2] * hb.z)) - ta.abs();
+    // B's face axis `j` (lane `j`): `Σ_i ha[i] |r[j][i]| + hb[j] - |r[j] · t|`, on the
+    // transposed matrix.
+    let row = |v: [Vec3A; 3], k: usize| Vec3A::new(v[0][k], v[1][k], v[2][k]);
+    let ra_b = row(ac, 0) * ha.x + row(ac, 1) * ha.y + row(ac, 2) * ha.z;
+    let d_b = row(c, 0) * ta.x + row(c, 1) * ta.y + row(c, 2) * ta.z;
+    let over_b = (ra_b + hb) - d_b.abs();
+    let face_normal = |k: usize| {
+        if k < 3 {
+            towards_b(Vec3::AXES[k], t[k])
+        } else {
+            towards_b(bx[k - 3], d_b[k - 3])
+        }
+    };
+    let face_kind = |k: usize| {
+        if k < 3 {
+            Axis::FaceA(k)
+        } else {
+            Axis::FaceB(k - 3)
+        }
+    };
+    let over_f = |k: usize| {
+        if k < 3 {
+            over_a[k]
+        } else {
+            over_b[k - 3]
+        }
+    };
+    let sep_f = sep(over_a) | sep(over_b) << 3;
+    if sep_f != 0 {
+        let k = sep_f.trailing_zeros() as usize;
+        return Err((-over_f(k), face_normal(k)));
     }
-    for i in 0..3 {
-        consider!(f.face_a(i), Vec3::AXES[i], Axis::FaceA(i));
+    // The least face overlap, the first on ties; none below infinity keeps the scalar
+    // test's initial `(∞, 0, FaceA(0))`.
+    let mut best = Real::INFINITY;
+    let mut best_k = usize::MAX;
+    let m = over_a.min(over_b).min_element();
+    if m < best {
+        let eq =
+            over_a.cmpeq(Vec3A::splat(m)).bitmask() | over_b.cmpeq(Vec3A::splat(m)).bitmask() << 3;
+        best_k = eq.trailing_zeros() as usize;
+        best = over_f(best_k);
     }
+    // The edge axes `e_i × b_j`, lane `i` of `over_e[j]`; parallel edges (length at most
+    // `1e3 ε`, not NaN) are masked out: the face axes decide.
+    let mut over_e = [Vec3A::ZERO; 3];
+    let mut dist_e = [Vec3A::ZERO; 3];
+    let mut len_e = [Vec3A::ZERO; 3];
+    let mut over_m = [Vec3A::ZERO; 3];
+    let mut valid = [0u32; 3];
+    let mut sep_e = [0u32; 3];
+    let inf = Vec3A::splat(Real::INFINITY);
+    let par = Vec3A::splat(1e3 * EPSILON);
     for j in 0..3 {
-        consider!(f.face_b(j), f.bx[j], Axis::FaceB(j));
+        let (j1, j2) = ((j + 1) % 3, (j + 2) % 3);
+        let (v1, v2) = (c[j].yzx(), c[j].zxy());
+        let l2 = v1 * v1 + v2 * v2;
+        let len = Vec3A::new(l2.x.sqrt(), l2.y.sqrt(), l2.z.sqrt());
+        let ra = ha.yzx() * ac[j].zxy() + ha.zxy() * ac[j].yzx();
+        let rb = ac[j2] * hb_s[j1] + ac[j1] * hb_s[j2];
+        let d = v1 * ta.zxy() - v2 * ta.yzx();
+        let inv = Vec3A::ONE / len;
+        let o = ((ra + rb) - d.abs()) * inv;
+        let ok = !len.cmple(par);
+        valid[j] = ok.bitmask() & 7;
+        sep_e[j] = sep(o) & valid[j];
+        over_e[j] = o;
+        over_m[j] = Vec3A::select(ok, o, inf);
+        dist_e[j] = d * inv;
+        len_e[j] = len;
     }
-    // Parallel edges (`None`): the face axes decide.
-    macro_rules! edge {
-        ($i:literal, $j:literal) => {
-            if let Some((overlap, dist, len)) = f.edge($i, $j) {
-                consider!(
-                    (overlap, dist),
-                    f.edge_axis($i, $j, len),
-                    Axis::Edge($i, $j)
-                );
+    let edge_normal = |i: usize, j: usize| {
+        let v = bx[j].to_array();
+        let (i1, i2) = ((i + 1) % 3, (i + 2) % 3);
+        let mut n = [0.0; 3];
+        n[i1] = -v[i2];
+        n[i2] = v[i1];
+        towards_b(Vec3::from_array(n) / len_e[j][i], dist_e[j][i])
+    };
+    // The lane masks of the three `b_j` as one 9-bit mask in the scalar test's order
+    // (`i` major: bit `3 i + j`), so its lowest bit is the first axis in that order.
+    let in_order = |m: [u32; 3]| {
+        let mut r = 0u32;
+        for (j, mj) in m.into_iter().enumerate() {
+            for i in 0..3 {
+                r |= (mj >> i & 1) << (3 * i + j);
             }
-        };
+        }
+        r
+    };
+    // The first separating edge axis.
+    let first_sep = in_order(sep_e);
+    if first_sep != 0 {
+        let k = first_sep.trailing_zeros() as usize;
+        let (i, j) = (k / 3, k % 3);
+        return Err((-over_e[j][i], edge_normal(i, j)));
     }
-    edge!(0, 0);
-    edge!(0, 1);
-    edge!(0, 2);
-    edge!(1, 0);
-    edge!(1, 1);
-    edge!(1, 2);
-    edge!(2, 0);
-    edge!(2, 1);
-    edge!(2, 2);
-    Ok(best)
+    let [m0, m1, m2] = over_m;
+    let m = m0.min(m1).min(m2).min_element();
+    if m < best {
+        let ms = Vec3A::splat(m);
+        let eq = in_order([
+            m0.cmpeq(ms).bitmask(),
+            m1.cmpeq(ms).bitmask(),
+            m2.cmpeq(ms).bitmask(),
+        ]);
+        let k = eq.trailing_zeros() as usize;
+        let (i, j) = (k / 3, k % 3);
+        return Ok((over_e[j][i], edge_normal(i, j), Axis::Edge(i, j)));
+    }
+    if best_k == usize::MAX {
+        return Ok((best, Vec3::ZERO, Axis::FaceA(0)));
+    }
+    Ok((best, face_normal(best_k), face_kind(best_k)))
+}
+
+/// A [`Vec3`] as a SIMD vector (the identity in f64, where `Vec3A` is `Vec3`).
+#[inline(always)]
+#[allow(clippy::useless_conversion)]
+fn va(v: Vec3) -> Vec3A {
+    v.into()
 }
 
 /// The witness points of an overlap found by [`cuboid_cuboid_sat`].
@@ -421,8 +520,23 @@ pub fn cuboid_cuboid_witness(
     n: Vec3,
     kind: Axis,
 ) -> Contact {
+    cuboid_cuboid_witness_mat(a, b, pose_ab, &pose_ab.rotation_matrix(), depth, n, kind)
+}
+
+/// [`cuboid_cuboid_witness`] with B's rotation matrix in A's frame (`rot`, which must be
+/// `pose_ab.rotation_matrix()`) already at hand, as the box–box manifold has it. The edge
+/// case indexes arrays rather than `Vec3`s by a runtime axis (a `match` per access); the
+/// arithmetic is the same, so the same bits.
+pub(crate) fn cuboid_cuboid_witness_mat(
+    a: &Cuboid,
+    b: &Cuboid,
+    pose_ab: &Isometry,
+    rot: &Mat3,
+    depth: Real,
+    n: Vec3,
+    kind: Axis,
+) -> Contact {
     let (ha, hb) = (a.half_extents(), b.half_extents());
-    let rot = pose_ab.rotation_matrix();
     let t = pose_ab.translation;
     let bx = [rot.x_axis, rot.y_axis, rot.z_axis];
     match kind {
@@ -450,14 +564,17 @@ pub fn cuboid_cuboid_witness(
         }
         Axis::Edge(i, j) => {
             // Edge of A: the support edge along e_i in +n; edge of B along b_j in -n.
-            let mut ca = Vec3::ZERO;
+            let (ha, hb, ns) = (ha.to_array(), hb.to_array(), n.to_array());
+            let mut ca = [0.0; 3];
             for k in 0..3 {
                 if k != i {
-                    ca[k] = if n[k] < 0.0 { -ha[k] } else { ha[k] };
+                    ca[k] = if ns[k] < 0.0 { -ha[k] } else { ha[k] };
                 }
             }
-            let mut ea = Vec3::ZERO;
+            let ca = Vec3::from_array(ca);
+            let mut ea = [0.0; 3];
             ea[i] = ha[i];
+            let ea = Vec3::from_array(ea);
             let mut cb = t;
             for l in 0..3 {
                 if l != j {
@@ -550,146 +667,5 @@ fn clip(poly: &[Vec3], k: usize, sign: Real, limit: Real) -> Poly {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::math::{consts::FRAC_PI_4, Quat};
-
-    /// The separating-axis test as it was, with the edge axes in a loop (runtime cyclic
-    /// indices) and the pose's own matrix: the oracle of the unrolled test.
-    fn axis_reference(
-        a: &Cuboid,
-        b: &Cuboid,
-        pose_ab: &Isometry,
-        prediction: Real,
-    ) -> Result<(Real, Vec3, Axis), (Real, Vec3)> {
-        let f = SatFrame::new(a.half_extents(), b.half_extents(), pose_ab);
-        let mut best = (Real::INFINITY, Vec3::ZERO, Axis::FaceA(0));
-        let mut consider = |(overlap, dist): (Real, Real),
-                            axis: &dyn Fn() -> Vec3,
-                            kind: Axis|
-         -> Result<(), (Real, Vec3)> {
-            if overlap < -prediction || overlap.is_nan() {
-                return Err((-overlap, towards_b(axis(), dist)));
-            }
-            if overlap < best.0 {
-                best = (overlap, towards_b(axis(), dist), kind);
-            }
-            Ok(())
-        };
-        for i in 0..3 {
-            consider(f.face_a(i), &|| Vec3::AXES[i], Axis::FaceA(i))?;
-        }
-        for j in 0..3 {
-            consider(f.face_b(j), &|| f.bx[j], Axis::FaceB(j))?;
-        }
-        for i in 0..3 {
-            for j in 0..3 {
-                if let Some((overlap, dist, len)) = f.edge(i, j) {
-                    consider(
-                        (overlap, dist),
-                        &|| f.edge_axis(i, j, len),
-                        Axis::Edge(i, j),
-                    )?;
-                }
-            }
-        }
-        Ok(best)
-    }
-
-    /// The unrolled test gives the loop's result bit for bit (axis, overlap, normal, or the
-    /// separating axis and gap): overlapping, touching, apart within and beyond the
-    /// prediction, parallel faces (identity and 90° turns, where edge axes vanish), 45°,
-    /// edge–edge crossings, thin and zero-thickness boxes, 1 km from the origin, NaN.
-    #[test]
-    fn unrolled_sat_matches_the_loop_bit_for_bit() {
-        let mut seed = 0x2545_f491_4f6c_dd1d_u64;
-        let mut rnd = || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 11) as Real / (1u64 << 53) as Real
-        };
-        let bits = |v: Vec3| v.to_array().map(Real::to_bits);
-        let (mut overlaps, mut aparts, mut edges) = (0, 0, 0);
-        for case in 0..30000 {
-            let mut h = || Vec3::new(0.05 + rnd(), 0.05 + rnd(), 0.05 + rnd());
-            let (ha, mut hb) = (h(), h());
-            if case % 13 == 0 {
-                hb.z = 1e-6; // (nearly) zero thickness
-            } else if case % 13 == 1 {
-                hb.y = 1e-3; // thin plate
-            }
-            let rot = match case % 6 {
-                0 => Quat::IDENTITY,
-                1 => Quat::from_rotation_z(crate::math::consts::FRAC_PI_2),
-                2 => Quat::from_rotation_y(FRAC_PI_4),
-                3 => Quat::from_rotation_x(FRAC_PI_4) * Quat::from_rotation_y(FRAC_PI_4),
-                4 => Quat::from_rotation_y(1e-5 * rnd()),
-                _ => Quat::from_axis_angle(
-                    Vec3::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5).normalize(),
-                    rnd() * 6.0,
-                ),
-            };
-            let mut t = Vec3::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5) * 4.0;
-            if case % 7 == 0 {
-                // Face to face, exactly touching along x.
-                t.x = ha.x + hb.x;
-            }
-            let (a, b) = (Cuboid::new(ha).unwrap(), Cuboid::new(hb).unwrap());
-            let mut pose = Isometry::new(t, rot);
-            if case % 5 == 0 {
-                // 1 km out: the relative pose of two world poses there (with its round-off).
-                let wa = Isometry::new(
-                    Vec3::new(1000.0, -1000.0, 1000.0),
-                    Quat::from_rotation_y(0.3 * rnd()),
-                );
-                pose = wa.inv_mul(&wa.mul(&pose));
-            }
-            let rot_m = pose.rotation_matrix();
-            for prediction in [0.0 as Real, 0.02, 5.0] {
-                let want = axis_reference(&a, &b, &pose, prediction);
-                let got = cuboid_cuboid_axis_or_separation_mat(
-                    &a,
-                    &b,
-                    &rot_m,
-                    pose.translation,
-                    prediction,
-                );
-                match (got, want) {
-                    (Ok((go, gn, gk)), Ok((wo, wn, wk))) => {
-                        assert_eq!((go.to_bits(), bits(gn), gk), (wo.to_bits(), bits(wn), wk));
-                        overlaps += 1;
-                        edges += matches!(gk, Axis::Edge(..)) as usize;
-                    }
-                    (Err((gd, gn)), Err((wd, wn))) => {
-                        assert_eq!((gd.to_bits(), bits(gn)), (wd.to_bits(), bits(wn)));
-                        aparts += 1;
-                    }
-                    (g, w) => panic!("case {case}: {g:?} vs {w:?}"),
-                }
-                let public = cuboid_cuboid_axis_or_separation(&a, &b, &pose, prediction);
-                assert_eq!(format!("{public:?}"), format!("{want:?}"));
-            }
-        }
-        // The paths the test means to cover do occur.
-        assert!(
-            overlaps > 1000 && aparts > 1000 && edges > 100,
-            "{overlaps} {aparts} {edges}"
-        );
-        // Non-finite input is rejected the same way.
-        let (a, b) = (
-            Cuboid::new(Vec3::ONE).unwrap(),
-            Cuboid::new(Vec3::ONE).unwrap(),
-        );
-        let pose = Isometry::new(Vec3::new(Real::NAN, 0.0, 0.0), Quat::IDENTITY);
-        let got = cuboid_cuboid_axis_or_separation_mat(
-            &a,
-            &b,
-            &pose.rotation_matrix(),
-            pose.translation,
-            0.02,
-        );
-        assert!(matches!(got, Err((d, _)) if d.is_nan()));
-        assert!(matches!(axis_reference(&a, &b, &pose, 0.02), Err((d, _)) if d.is_nan()));
-    }
-}
+#[path = "contact_cuboid_cuboid_tests.rs"]
+mod tests;
