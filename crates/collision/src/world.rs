@@ -77,6 +77,20 @@ pub struct CollisionObject {
     displacement: Vec3,
 }
 
+impl CollisionObject {
+    /// Stores what [`CollisionWorld::sync_object`] computed; the object is up to date (a
+    /// pending `set_pose` must not be applied again by `update`).
+    #[inline(always)]
+    fn set_synced(&mut self, pose: Isometry, margin: Real, motion: Vec3, aabb: Aabb, d: Vec3) {
+        self.pose = pose;
+        self.margin = margin;
+        self.motion = motion;
+        self.aabb = aabb;
+        self.displacement = d;
+        self.dirty = false;
+    }
+}
+
 /// Pairs of objects that started or stopped overlapping (broadphase boxes) at an update.
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
 pub struct WorldPairChanges {
@@ -129,6 +143,14 @@ fn speculative_box(aabb: Aabb, margin: Real, motion: Vec3) -> Aabb {
     let own = (margin - motion.length()).max(0.0);
     let m = Vec3::splat(own);
     Aabb::new(aabb.min - m, aabb.max + m).swept(motion)
+}
+
+/// True when `sum`, a sum of values, shows them all finite: a NaN or infinite term makes the
+/// sum NaN or infinite, and then `sum * 0` is NaN. (A sum of finite terms can overflow: the
+/// caller then takes its slow, exact checks.)
+#[inline(always)]
+fn finite_sum(sum: Real) -> bool {
+    sum * 0.0 == 0.0
 }
 
 /// Objects plus a broadphase (see the module docs).
@@ -286,39 +308,60 @@ impl CollisionWorld {
         motion: Vec3,
     ) -> Result<()> {
         let i = self.slot(h)?;
-        let pose = check_pose_fast(pose)?;
-        // One test for the usual case; the named checks (which build the errors) only when
-        // it fails.
-        if !(margin.is_finite() && margin >= 0.0 && motion.is_finite()) {
-            crate::math::check_non_negative("margin", margin)?;
-            crate::math::check_finite_vec("motion", motion)?;
-        }
         let Some(o) = self.objects[i].as_mut() else {
             return Err(CaromError::UnknownHandle(format!("{h:?}")));
         };
+        // The usual case first: box and displacement from the pose as given, then one test
+        // of everything (`finite_sum` is finite only when every term is, and a sum that
+        // overflows only sends a valid pose to the named checks, which pass it). Anything
+        // else takes the named checks, in their order, which build the errors and may
+        // renormalise the rotation.
+        let aabb = speculative_box(o.shape.aabb(&pose), margin, motion);
+        let displacement = pose.translation - o.pose.translation;
+        let q = pose.rotation;
+        let sum = (pose.translation + motion + displacement + aabb.min + aabb.max).element_sum()
+            + (q.x + q.y)
+            + (q.z + q.w)
+            + margin;
+        if !(finite_sum(sum)
+            && margin >= 0.0
+            && (q.length_squared() - 1.0).abs() <= 4.0 * Real::EPSILON
+            && aabb.min.cmple(aabb.max).all())
+        {
+            return self.sync_object_checked(i, pose, margin, motion);
+        }
+        self.broadphase
+            .update_proxy_checked(h.proxy(), &aabb, displacement)?;
+        o.set_synced(pose, margin, motion, aabb, displacement);
+        Ok(())
+    }
+
+    /// [`CollisionWorld::sync_object`] with every argument checked by name, for the poses
+    /// its single test did not pass (invalid values, a rotation to renormalise, or values so
+    /// large that their sum overflows).
+    #[cold]
+    #[inline(never)]
+    fn sync_object_checked(
+        &mut self,
+        i: usize,
+        pose: Isometry,
+        margin: Real,
+        motion: Vec3,
+    ) -> Result<()> {
+        let pose = check_pose_fast(pose)?;
+        crate::math::check_non_negative("margin", margin)?;
+        crate::math::check_finite_vec("motion", motion)?;
+        let o = self.objects[i].as_mut().expect("slot checked");
         let aabb = speculative_box(o.shape.aabb(&pose), margin, motion);
         let displacement = pose.translation - o.pose.translation;
         // A pose far out can overflow the box or the displacement: checked before anything
         // changes, so the broadphase can take them unchecked (the handle is live: an object
-        // and its proxy share it). The fast test is `check_aabb`'s and `check_finite_vec`'s
-        // condition.
-        if !(aabb.min.is_finite()
-            && aabb.max.is_finite()
-            && aabb.min.cmple(aabb.max).all()
-            && displacement.is_finite())
-        {
-            crate::math::check_aabb(&aabb)?;
-            crate::math::check_finite_vec("displacement", displacement)?;
-        }
+        // and its proxy share it).
+        crate::math::check_aabb(&aabb)?;
+        crate::math::check_finite_vec("displacement", displacement)?;
         self.broadphase
-            .update_proxy_checked(h.proxy(), &aabb, displacement)?;
-        o.pose = pose;
-        o.margin = margin;
-        o.motion = motion;
-        o.aabb = aabb;
-        o.displacement = displacement;
-        // Already up to date: a pending `set_pose` must not be applied again by `update`.
-        o.dirty = false;
+            .update_proxy_checked(o.handle.proxy(), &aabb, displacement)?;
+        o.set_synced(pose, margin, motion, aabb, displacement);
         Ok(())
     }
 

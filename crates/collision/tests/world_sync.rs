@@ -140,3 +140,31 @@ fn sync_object_rejects_bad_input_and_changes_nothing() {
         .unwrap();
     assert!((w.get(h).unwrap().pose.rotation.length() - 1.0).abs() <= 4.0 * Real::EPSILON);
 }
+
+/// Valid values whose sum overflows (the fast path's single finiteness test fails) are
+/// accepted by the named checks, and give the deferred path's box.
+#[test]
+fn sync_object_accepts_finite_values_whose_sum_overflows() {
+    let big = 0.6 * Real::MAX;
+    let shape: Arc<Shape> = Arc::new(Sphere::new(0.5).unwrap().into());
+    let mut a = CollisionWorld::new(Method::Tree);
+    let mut b = CollisionWorld::new(Method::Tree);
+    let ha = a
+        .add(shape.clone(), Isometry::IDENTITY, Filter::default())
+        .unwrap();
+    let hb = b.add(shape, Isometry::IDENTITY, Filter::default()).unwrap();
+    for (x, margin, motion) in [
+        (big, 0.0, Vec3::ZERO),
+        (0.9 * big, 0.25, Vec3::new(0.0, 0.1, 0.0)),
+        (0.0, 0.0, Vec3::ZERO), // back to the origin: touching zero margin
+    ] {
+        let pose = Isometry::from_translation(Vec3::new(x, x, 1.0));
+        a.sync_object(ha, pose, margin, motion).unwrap();
+        b.set_pose_with_margin(hb, pose, margin).unwrap();
+        b.set_motion(hb, motion).unwrap();
+        b.update().unwrap();
+        let (oa, ob) = (a.get(ha).unwrap(), b.get(hb).unwrap());
+        assert_eq!((oa.pose, oa.aabb), (ob.pose, ob.aabb), "x = {x}");
+        assert!(oa.aabb.min.is_finite() && oa.aabb.max.is_finite());
+    }
+}

@@ -125,6 +125,7 @@ impl AnyBroadPhase {
     /// [`BroadPhase::update_proxy`] for a caller that has checked that `proxy` is live, that
     /// `aabb` is finite with `min <= max` and that `displacement` is finite: the two-tree
     /// method skips its checks, the others take the checked path.
+    #[inline]
     pub(crate) fn update_proxy_checked(
         &mut self,
         proxy: ProxyHandle,

@@ -197,18 +197,33 @@ impl TreeBroadPhase {
     /// handle (slot `i` is live), the box (finite, `min <= max`) and the displacement
     /// (finite): the collision world's per-step sync, where the checks were a third of the
     /// update's instructions.
+    ///
+    /// The usual case (the box still inside its fat box, which is not too large) is inline
+    /// and touches the tree only to read the leaf's fat box; a new fat box is set out of
+    /// line ([`TreeBroadPhase::set_new_fat`]), so the common path pays no large frame.
+    #[inline]
     pub(crate) fn update_slot(&mut self, i: usize, aabb: &Aabb, displacement: Vec3) {
         self.store.set_aabb_trusted(i, *aabb);
         let (t, leaf) = self.leaves[i];
-        let changed = if t == MOVING && self.refit_moving {
-            self.trees[t].refit_leaf(leaf.index, aabb, displacement)
-        } else {
-            self.trees[t].move_leaf(leaf.index, aabb, displacement)
-        };
-        if changed {
-            self.fat[i] = self.trees[t].leaf_fat(leaf.index);
-            self.mark_moved(i as u32);
+        if self.trees[t].needs_new_fat(leaf.index as usize, aabb, displacement) {
+            self.set_new_fat(i, aabb, displacement);
         }
+    }
+
+    /// Gives slot `i`'s leaf a new fat box for `aabb` moving by `displacement` (refitted in
+    /// place in the moving tree, re-inserted otherwise) and marks it moved.
+    #[inline(never)]
+    fn set_new_fat(&mut self, i: usize, aabb: &Aabb, displacement: Vec3) {
+        let (t, leaf) = self.leaves[i];
+        let tree = &mut self.trees[t];
+        if t == MOVING && self.refit_moving {
+            tree.refit_fat(leaf.index, aabb, displacement);
+        } else {
+            let fat = tree.fat_aabb(aabb, displacement);
+            tree.move_proxy_fat(leaf.index, fat);
+        }
+        self.fat[i] = self.trees[t].leaf_fat(leaf.index);
+        self.mark_moved(i as u32);
     }
 
     /// Adds to `out` the candidate keys of moved proxy `m` against tree `t`. A pair of two

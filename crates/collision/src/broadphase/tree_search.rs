@@ -265,32 +265,28 @@ fn merge_range(
     next: &mut Vec<u64>,
     exact: &mut Vec<u64>,
 ) {
-    let (mut i, mut j) = (0, 0);
-    while i < old.len() && j < new.len() {
-        let (o, n) = (old[i], new[j]);
-        let k = if o < n {
-            // Only in the surviving candidates.
-            i += 1;
-            if !view.unchanged(o) {
-                continue;
+    // Per new key: first the run of surviving candidates below it (most of the work, in
+    // a loop with one comparison per key), then the new key itself (dropping its old copy).
+    let mut i = 0;
+    for &n in new {
+        while let Some(&o) = old.get(i) {
+            if o >= n {
+                i += (o == n) as usize;
+                break;
             }
-            o
-        } else {
-            j += 1;
-            i += (o == n) as usize;
-            n
-        };
-        next.push(k);
-        view.emit(k, exact);
+            i += 1;
+            if view.unchanged(o) {
+                next.push(o);
+                view.emit(o, exact);
+            }
+        }
+        next.push(n);
+        view.emit(n, exact);
     }
     for &o in &old[i..] {
         if view.unchanged(o) {
             next.push(o);
             view.emit(o, exact);
         }
-    }
-    for &n in &new[j..] {
-        next.push(n);
-        view.emit(n, exact);
     }
 }

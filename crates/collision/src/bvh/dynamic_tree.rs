@@ -308,6 +308,14 @@ impl DynamicTree {
         if !self.needs_new_fat(i, aabb, displacement) {
             return false;
         }
+        self.refit_fat(leaf, aabb, displacement);
+        true
+    }
+
+    /// The refit of [`DynamicTree::refit_leaf`] once [`DynamicTree::needs_new_fat`] said
+    /// yes: the leaf takes a fresh fat box and its ancestors are refitted.
+    pub(crate) fn refit_fat(&mut self, leaf: u32, aabb: &Aabb, displacement: Vec3) {
+        let i = leaf as usize;
         self.nodes[i].aabb = self.fat_aabb(aabb, displacement);
         let mut p = self.nodes[i].parent;
         while p != NULL {
@@ -322,14 +330,13 @@ impl DynamicTree {
             self.nodes[p as usize].aabb = merged;
             p = n.parent;
         }
-        true
     }
 
     /// True when leaf `i`'s fat box must be replaced for the object box `aabb` moving by
     /// `displacement`: the box left it, or the fat box is far larger than a fresh one (the
     /// object stopped; a stale sweep would keep producing useless candidate pairs).
-    #[inline]
-    fn needs_new_fat(&self, i: usize, aabb: &Aabb, displacement: Vec3) -> bool {
+    #[inline(always)]
+    pub(crate) fn needs_new_fat(&self, i: usize, aabb: &Aabb, displacement: Vec3) -> bool {
         let fat = self.nodes[i].aabb;
         if !fat.contains(aabb) {
             return true;
