@@ -13,7 +13,7 @@ use super::convex::{
     capsule_capsule_manifold, capsule_polyhedron_manifold, perturbed_contacts,
     plane_capsule_manifold,
 };
-use super::manifold::{ContactManifold, ManifoldConfig};
+use super::manifold::{to_vec3, to_vec3a, ContactManifold, ManifoldConfig};
 use super::mesh::{mesh_convex_contacts, mesh_hull_contacts, mix_feature, ContactTriangles};
 use super::polyhedron::{
     plane_polyhedron_manifold, polyhedron_manifold_guided, polyhedron_manifold_into, Polyhedron,
@@ -601,20 +601,6 @@ impl Dispatcher {
             Ok(())
         })
     }
-}
-
-/// A SIMD vector back to [`Vec3`] (the identity in f64, where `Vec3A` is `Vec3`).
-#[inline(always)]
-#[allow(clippy::useless_conversion)]
-fn to_vec3(v: Vec3A) -> Vec3 {
-    v.into()
-}
-
-/// A [`Vec3`] as a SIMD vector (the identity in f64).
-#[inline(always)]
-#[allow(clippy::useless_conversion)]
-fn to_vec3a(v: Vec3) -> Vec3A {
-    v.into()
 }
 
 /// Appends to `out` the contacts `contacts` (in A's frame) as [`ContactPoint`]s:

@@ -378,14 +378,14 @@ impl ContactManifold {
 /// A SIMD vector back to [`Vec3`] (the identity in f64, where `Vec3A` is `Vec3`).
 #[inline(always)]
 #[allow(clippy::useless_conversion)]
-fn to_vec3(v: Vec3A) -> Vec3 {
+pub(crate) fn to_vec3(v: Vec3A) -> Vec3 {
     v.into()
 }
 
 /// A [`Vec3`] as a SIMD vector (the identity in f64).
 #[inline(always)]
 #[allow(clippy::useless_conversion)]
-fn to_vec3a(v: Vec3) -> Vec3A {
+pub(crate) fn to_vec3a(v: Vec3) -> Vec3A {
     v.into()
 }
 
