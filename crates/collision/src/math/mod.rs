@@ -26,6 +26,9 @@ mod types {
     pub type Quat = glam::Quat;
     /// A 3x3 column-major matrix of [`Real`].
     pub type Mat3 = glam::Mat3;
+    /// A 3x3 matrix of 16-byte aligned (SIMD) columns for hot loops; [`Mat3`] itself in
+    /// `f64`. Its products are the same operations, lane by lane, as [`Mat3`]'s.
+    pub type Mat3A = glam::Mat3A;
     /// Mathematical constants at [`Real`] precision.
     pub use std::f32::consts;
 }
@@ -42,6 +45,9 @@ mod types {
     pub type Quat = glam::DQuat;
     /// A 3x3 column-major matrix of [`Real`].
     pub type Mat3 = glam::DMat3;
+    /// A 3x3 matrix of 16-byte aligned (SIMD) columns for hot loops; [`Mat3`] itself in
+    /// `f64`. Its products are the same operations, lane by lane, as [`Mat3`]'s.
+    pub type Mat3A = glam::DMat3;
     /// Mathematical constants at [`Real`] precision.
     pub use std::f64::consts;
 }
