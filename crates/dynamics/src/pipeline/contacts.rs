@@ -10,9 +10,9 @@
 //! built and then moved), and entry `k` keeps the index of its narrowphase pair in
 //! `sources[k]`, so the write-back jumps from pair to pair (`Iterator::nth` on the pair
 //! slice is a pointer step) instead of walking and filtering every pair. While copying, the
-//! gather sums `0 · x` over every value it hands on (zero exactly when all are finite, the
-//! test of `DynamicsWorld`'s `plausible`), so the dynamics step need not check each manifold
-//! again.
+//! gather sums every value it hands on (finite when all are, short of an overflow beyond
+//! 10³⁸: the test of `DynamicsWorld`'s `plausible` up to a needless validation), so the
+//! dynamics step need not check each manifold again.
 //!
 //! The frames need no per-manifold sign: `orthonormal_basis(n)` returns `(t₁, t₂)` with
 //! `t₁ × t₂ = n`, so for the solver's normal `n = −n_B` its second tangent `n × t₁` is
@@ -21,22 +21,11 @@
 
 use super::World;
 use crate::body::{mix_friction, mix_restitution, BodyType};
+use crate::body_set::{BodyHandle, BodySet};
 use crate::contact::ContactManifold;
 use carom_collision::math::{orthonormal_basis, Real, Vec3};
-use carom_collision::narrowphase::ContactPoint as NarrowPoint;
+use carom_collision::narrowphase::PairContact;
 use carom_collision::world::ObjectHandle;
-
-/// The normal on B (from B towards A) of the deepest point (the first of equally deep ones).
-#[inline]
-fn deepest_normal(points: &[NarrowPoint]) -> Vec3 {
-    let mut deepest = &points[0];
-    for p in &points[1..] {
-        if p.distance < deepest.distance {
-            deepest = p;
-        }
-    }
-    deepest.normal
-}
 
 impl World {
     /// Fills `self.contacts` from the narrowphase (see the module docs). Returns true when
@@ -53,70 +42,8 @@ impl World {
             sources,
             ..
         } = self;
-        let set = dynamics.bodies();
-        let body = |o: ObjectHandle| body_of.get(o.index as usize).copied().flatten();
-        let mut k = 0;
-        let mut zero: Real = 0.0;
-        let mut ranges_ok = true;
-        for (index, pc) in collision.narrowphase().pairs().enumerate() {
-            let points = &pc.manifold.points;
-            if points.is_empty() || pc.sensor {
-                continue;
-            }
-            let (Some(ba), Some(bb)) = (body(pc.a), body(pc.b)) else {
-                continue;
-            };
-            // One at a time: a tuple of the two `Result`s (with their error payloads) was
-            // built on the stack for every manifold (~30 instructions of copies).
-            let Ok(ia) = set.slot(ba) else {
-                continue;
-            };
-            let Ok(ib) = set.slot(bb) else {
-                continue;
-            };
-            let (info_a, info_b) = (&set.info[ia], &set.info[ib]);
-            let dynamic = |t: BodyType| t == BodyType::Dynamic;
-            if !(dynamic(info_a.body_type) || dynamic(info_b.body_type)) || ba == bb {
-                continue;
-            }
-            let n_b = deepest_normal(points);
-            if !n_b.is_finite() || (n_b.length_squared() - 1.0).abs() > 1e-3 {
-                continue;
-            }
-            let (t1, _) = orthonormal_basis(n_b);
-            if k == contacts.len() {
-                contacts.push(ContactManifold::new(ba, bb, -n_b));
-                sources.push(0);
-            }
-            let m = &mut contacts[k];
-            m.body_a = ba;
-            m.body_b = bb;
-            m.normal = -n_b;
-            m.tangent = t1;
-            m.friction = mix_friction(info_a.friction, info_b.friction);
-            m.restitution = mix_restitution(info_a.restitution, info_b.restitution);
-            zero += m.friction * 0.0;
-            ranges_ok &= m.friction >= 0.0 && (0.0..=1.0).contains(&m.restitution);
-            let mut len = 0;
-            for (q, p) in m.points.iter_mut().zip(points) {
-                q.local_a = p.local_a;
-                q.local_b = p.local_b;
-                q.separation = p.distance;
-                q.feature_id = p.feature;
-                q.normal_impulse = p.normal_impulse;
-                q.tangent_impulse = [p.tangent_impulse[0], -p.tangent_impulse[1]];
-                zero += (p.local_a * 0.0 + p.local_b * 0.0).element_sum()
-                    + (p.distance + p.normal_impulse + p.tangent_impulse[0] + p.tangent_impulse[1])
-                        * 0.0;
-                len += 1;
-            }
-            m.len = len;
-            sources[k] = index as u32;
-            k += 1;
-        }
-        contacts.truncate(k);
-        sources.truncate(k);
-        zero == 0.0 && ranges_ok
+        let pairs = collision.narrowphase().pairs();
+        gather_pairs(dynamics.bodies(), body_of, pairs, contacts, sources)
     }
 
     /// Stores the solver's impulses into the narrowphase points the contacts came from.
@@ -143,6 +70,106 @@ impl World {
     pub(super) fn contact_point_count(&self) -> usize {
         self.contacts.iter().map(|m| m.points().len()).sum()
     }
+}
+
+/// [`World::gather`] over `pairs` (the narrowphase's, in pair order): fills `contacts` and
+/// `sources` in place and returns whether every value handed on is certainly valid.
+///
+/// One pass per manifold: the points are copied while the deepest one is found (its normal
+/// is the manifold's), and the values are summed rather than multiplied by zero and summed:
+/// a sum of finite values is finite unless it overflows (beyond 10³⁸, no scene's values), and
+/// any infinite or NaN value makes it infinite or NaN, so `sum.is_finite()` is true only when
+/// all are finite. A false "not certain" costs the step a validation, never other bits.
+/// The manifolds are the same bits as `gather_reference`'s (the previous routine, kept as
+/// the test oracle in `contacts_tests.rs`).
+pub(super) fn gather_pairs<'p>(
+    set: &BodySet,
+    body_of: &[Option<BodyHandle>],
+    pairs: impl Iterator<Item = &'p PairContact<ObjectHandle>>,
+    contacts: &mut Vec<ContactManifold>,
+    sources: &mut Vec<u32>,
+) -> bool {
+    let body = |o: ObjectHandle| body_of.get(o.index as usize).copied().flatten();
+    let mut k = 0;
+    let mut sum: Real = 0.0;
+    let mut ranges_ok = true;
+    for (index, pc) in pairs.enumerate() {
+        let points = &pc.manifold.points[..];
+        let Some(first) = points.first() else {
+            continue;
+        };
+        if pc.sensor {
+            continue;
+        }
+        let (Some(ba), Some(bb)) = (body(pc.a), body(pc.b)) else {
+            continue;
+        };
+        // One at a time: a tuple of the two `Result`s (with their error payloads) was
+        // built on the stack for every manifold (~30 instructions of copies).
+        let Ok(ia) = set.slot(ba) else {
+            continue;
+        };
+        let Ok(ib) = set.slot(bb) else {
+            continue;
+        };
+        let (info_a, info_b) = (&set.info[ia], &set.info[ib]);
+        let dynamic = |t: BodyType| t == BodyType::Dynamic;
+        if !(dynamic(info_a.body_type) || dynamic(info_b.body_type)) || ba == bb {
+            continue;
+        }
+        if k == contacts.len() {
+            contacts.push(ContactManifold::new(ba, bb, Vec3::Z));
+            sources.push(0);
+        }
+        let m = &mut contacts[k];
+        // The deepest point (the first of equally deep ones), found while copying: the
+        // comparisons are those of a separate scan (`first` against itself is false).
+        let mut deepest = first;
+        let mut len = 0;
+        // This manifold's sum, counted only if the manifold is handed on.
+        let mut values: Real = 0.0;
+        for (q, p) in m.points.iter_mut().zip(points) {
+            if p.distance < deepest.distance {
+                deepest = p;
+            }
+            q.local_a = p.local_a;
+            q.local_b = p.local_b;
+            q.separation = p.distance;
+            q.feature_id = p.feature;
+            q.normal_impulse = p.normal_impulse;
+            q.tangent_impulse = [p.tangent_impulse[0], -p.tangent_impulse[1]];
+            values += (p.local_a + p.local_b).element_sum()
+                + ((p.distance + p.normal_impulse) + (p.tangent_impulse[0] + p.tangent_impulse[1]));
+            len += 1;
+        }
+        // More points than a solver manifold holds (not from the narrowphase, which keeps
+        // four): the deepest of all of them still gives the normal.
+        for p in points.get(len..).unwrap_or_default() {
+            if p.distance < deepest.distance {
+                deepest = p;
+            }
+        }
+        let n_b = deepest.normal;
+        if !n_b.is_finite() || (n_b.length_squared() - 1.0).abs() > 1e-3 {
+            // The copied points stay unused: entry `k` is refilled or truncated.
+            continue;
+        }
+        let (t1, _) = orthonormal_basis(n_b);
+        m.len = len;
+        m.body_a = ba;
+        m.body_b = bb;
+        m.normal = -n_b;
+        m.tangent = t1;
+        m.friction = mix_friction(info_a.friction, info_b.friction);
+        m.restitution = mix_restitution(info_a.restitution, info_b.restitution);
+        sum += values + m.friction;
+        ranges_ok &= m.friction >= 0.0 && (0.0..=1.0).contains(&m.restitution);
+        sources[k] = index as u32;
+        k += 1;
+    }
+    contacts.truncate(k);
+    sources.truncate(k);
+    sum.is_finite() && ranges_ok
 }
 
 #[cfg(test)]

@@ -44,6 +44,8 @@
 //! `|v_a − v_b|·dt` (plus each body's rotational sweep), not the sum of both speeds.
 
 mod contacts;
+#[cfg(test)]
+mod contacts_tests;
 pub mod queries;
 mod scene;
 pub mod snapshot;
