@@ -15,7 +15,7 @@ use carom_collision::math::{Real, Vec3};
 
 #[path = "contact_prepare.rs"]
 mod prep;
-pub(crate) use prep::{ConstraintSink, PreparedHead, PreparedPoint, Preparer};
+pub(crate) use prep::Preparer;
 
 #[cfg(test)]
 #[path = "contact_tests.rs"]

@@ -1,7 +1,8 @@
 //! Preparing one contact constraint (module `contact`): the lever arms, the warm-start
 //! impulses and the friction frame of a manifold, handed to a [`ConstraintSink`] point by
-//! point, so the scalar solve gets a [`ContactConstraint`] with its Jacobian rows and the
-//! SIMD build writes its lanes directly (module `contact_simd`), from the same arithmetic.
+//! point, so the scalar solve gets a [`ContactConstraint`] with its Jacobian rows. The SIMD
+//! build repeats this arithmetic on four lanes at once (`contact_simd_prep`), and its
+//! tests compare every lane with this routine's bits.
 
 use super::{ContactConstraint, ContactRow, Softness, SolverBody};
 use crate::body_set::BodySet;
@@ -38,8 +39,7 @@ impl Preparer<'_> {
         self.make_into(k, &mut ScalarSink { out, rows });
     }
 
-    /// Prepares the constraint at position `k` of the colour order into `sink` (the SIMD
-    /// build writes it straight into a lane of a wide constraint, module `contact_simd`).
+    /// Prepares the constraint at position `k` of the colour order into `sink`.
     #[inline(always)]
     pub(crate) fn make_into(&self, k: usize, sink: &mut impl ConstraintSink) {
         let m_index = self.selected[self.order[k]];
@@ -101,8 +101,7 @@ pub(crate) struct PreparedHead {
 /// The receiver of a prepared constraint ([`prepare_one`]): the points as they are
 /// computed (`point`, indices `0..len` in order), then the constraint's head (`head`). A
 /// receiver writes each value where its solve reads it, so the preparation writes no
-/// intermediate scalar constraint that would be copied again (Box2D v3's
-/// `b2PrepareContactsTask` writes its SIMD lanes directly too).
+/// intermediate value that would be copied again.
 pub(crate) trait ConstraintSink {
     /// Point `k` with the bodies `a`, `b` and the unit normal `n` of the constraint.
     fn point(&mut self, k: usize, p: &PreparedPoint, a: &SolverBody, b: &SolverBody, n: Vec3);

@@ -24,9 +24,15 @@ use std::ops::Range;
 mod build;
 #[cfg(test)]
 pub(crate) use build::store;
-pub(crate) use build::{assign, build_range, store_range};
+pub(crate) use build::{assign, store_range};
+
+#[path = "contact_simd_prep.rs"]
+mod prep;
 #[cfg(test)]
 pub(crate) use build::{build, fill, write_back};
+pub(crate) use prep::build_range_wide;
+#[cfg(test)]
+pub(crate) use prep::build_range_wide_on;
 
 #[path = "contact_simd_run.rs"]
 mod run;

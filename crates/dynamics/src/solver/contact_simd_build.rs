@@ -10,9 +10,7 @@
 
 use super::{WideConstraint, WidePoint, WideRow, WideScratch, LANES, NONE, NO_SLOT, V3, W};
 use crate::contact::{ContactManifold, MAX_MANIFOLD_POINTS};
-use crate::solver::contact::{
-    ConstraintSink, ContactConstraint, PointConstraint, PreparedHead, PreparedPoint, Preparer,
-};
+use crate::solver::contact::{ContactConstraint, PointConstraint};
 use crate::solver::SolverBody;
 use carom_collision::math::{Mat3, Real, Vec3};
 use std::ops::Range;
@@ -33,7 +31,7 @@ fn put3(v: &mut V3, l: usize, x: Vec3) {
 
 /// `x` as a lane index of a [`WideConstraint`] (body slot, manifold index).
 #[inline(always)]
-fn lane_index(x: usize) -> u32 {
+pub(super) fn lane_index(x: usize) -> u32 {
     let i = u32::try_from(x).unwrap_or(NO_SLOT);
     assert!(
         i != NO_SLOT,
@@ -57,6 +55,25 @@ fn get3(v: &V3, l: usize) -> Vec3 {
 pub(crate) struct RowInputs {
     inv_i_a: [[W; 3]; 3],
     inv_i_b: [[W; 3]; 3],
+}
+
+impl RowInputs {
+    /// The inverse world inertias of the bodies `a[l]`, `b[l]` of every lane `l` (those of
+    /// padding lanes are never read: their rows are zero).
+    #[inline(always)]
+    pub(super) fn set(&mut self, a: &[&SolverBody; LANES], b: &[&SolverBody; LANES]) {
+        let lanes = |bs: &[&SolverBody; LANES], c: usize, r: usize| {
+            W::from(std::array::from_fn::<Real, LANES, _>(|l| {
+                bs[l].inv_i.col(c)[r]
+            }))
+        };
+        for c in 0..3 {
+            for r in 0..3 {
+                self.inv_i_a[c][r] = lanes(a, c, r);
+                self.inv_i_b[c][r] = lanes(b, c, r);
+            }
+        }
+    }
 }
 
 /// Sets lane `l` of the lane-form matrix `w` (`w[c][r]`: column `c`, row `r`) to `m`.
@@ -132,6 +149,12 @@ impl WideConstraint {
         }
     }
 
+    /// Lane `l` becomes a padding lane (no points, no bodies; zero inverse inertias in
+    /// `inputs`).
+    pub(super) fn set_padding(&mut self, l: usize, inputs: &mut RowInputs) {
+        self.set_lane(l, None, &[], inputs);
+    }
+
     /// Lane `l` becomes constraint `c` (whose bodies are `bodies[c.a]`, `bodies[c.b]`), or a
     /// padding lane (no points, no bodies) for `None`. Every field of the lane is written
     /// but the rows and the points from `c.len` on (the points keep their lever arms); the
@@ -181,13 +204,20 @@ impl WideConstraint {
     /// zero. Points from `len` on are never read and keep whatever they held: with the
     /// constraints of a colour grouped by point count, most groups have lanes of equal
     /// length, and a group of one-point lanes builds one point instead of four.
-    fn finish(&mut self, inputs: &RowInputs) {
+    pub(super) fn finish(&mut self, inputs: &RowInputs) {
         for l in 0..LANES {
             for k in self.lens[l] as usize..self.len {
                 self.points[k].set_lane(l, &PointConstraint::ZERO);
                 put(&mut self.relative_velocity[k], l, 0.0);
             }
         }
+        self.finish_rows(inputs);
+    }
+
+    /// The rows half of [`WideConstraint::finish`], for lanes whose points `lens[l]..len`
+    /// are already zero.
+    #[inline(always)]
+    pub(super) fn finish_rows(&mut self, inputs: &RowInputs) {
         let (ia, ib) = (&inputs.inv_i_a, &inputs.inv_i_b);
         let inv_m = self.inv_m_a + self.inv_m_b;
         let lens = W::from(std::array::from_fn::<Real, LANES, _>(|l| {
@@ -316,6 +346,7 @@ pub(crate) fn assign(
 }
 
 /// Where [`build_range`] gets the constraint of each lane from.
+#[cfg(test)]
 pub(crate) trait LaneSource {
     /// Writes the constraint at position `k` of the colour order into lane `l` of `w`, as
     /// [`WideConstraint::set_lane`] writes a prepared one (the inverse inertias into
@@ -332,7 +363,7 @@ pub(crate) trait LaneSource {
 
 /// A [`LaneSource`] that prepares each constraint into a scalar [`ContactConstraint`] with
 /// `make(k, c, false)` and copies it into its lane ([`WideConstraint::set_lane`]): the
-/// tests' route, and the oracle of the direct one ([`Preparer`] as a [`LaneSource`]).
+/// tests' route, and the oracle of the wide build (`contact_simd_prep`).
 #[cfg(test)]
 pub(crate) struct ViaScalar<F>(pub F);
 
@@ -353,75 +384,12 @@ impl<F: Fn(usize, &mut ContactConstraint, bool)> LaneSource for ViaScalar<F> {
     }
 }
 
-/// A [`ConstraintSink`] writing one prepared constraint straight into lane `l` of a wide
-/// constraint: the values [`WideConstraint::set_lane`] would copy from the scalar
-/// constraint, without building it.
-struct LaneSink<'a> {
-    w: &'a mut WideConstraint,
-    l: usize,
-    inputs: &'a mut RowInputs,
-}
-
-impl ConstraintSink for LaneSink<'_> {
-    #[inline(always)]
-    fn point(&mut self, k: usize, p: &PreparedPoint, _: &SolverBody, _: &SolverBody, _: Vec3) {
-        let (l, wp) = (self.l, &mut self.w.points[k]);
-        put3(&mut wp.arm_a, l, p.arm_a);
-        put3(&mut wp.arm_b, l, p.arm_b);
-        put(&mut wp.separation, l, p.separation);
-        put(&mut wp.normal_impulse, l, p.normal_impulse);
-        put(&mut wp.tangent_impulse[0], l, p.tangent_impulse[0]);
-        put(&mut wp.tangent_impulse[1], l, p.tangent_impulse[1]);
-        put(&mut wp.max_normal_impulse, l, 0.0);
-        put(&mut self.w.relative_velocity[k], l, p.relative_velocity);
-    }
-
-    #[inline(always)]
-    fn head(&mut self, h: &PreparedHead, a: &SolverBody, b: &SolverBody) {
-        let (l, w) = (self.l, &mut *self.w);
-        w.a[l] = lane_index(h.a);
-        w.b[l] = lane_index(h.b);
-        w.write_a[l] = a.dynamic;
-        w.write_b[l] = b.dynamic;
-        w.manifold[l] = lane_index(h.manifold);
-        w.lens[l] = h.len as u32;
-        put(&mut w.inv_m_a, l, a.inv_m);
-        put(&mut w.inv_m_b, l, b.inv_m);
-        put_mat(&mut self.inputs.inv_i_a, l, &a.inv_i);
-        put_mat(&mut self.inputs.inv_i_b, l, &b.inv_i);
-        put3(&mut w.normal, l, h.normal);
-        put3(&mut w.tangent, l, h.tangent[0]);
-        put(&mut w.friction, l, h.friction);
-        put(&mut w.restitution, l, h.restitution);
-        put(&mut w.bias_rate, l, h.softness.bias_rate);
-        put(&mut w.mass_scale, l, h.softness.mass_scale);
-        put(&mut w.impulse_scale, l, h.softness.impulse_scale);
-    }
-}
-
-/// The direct route: [`Preparer::make_into`] writes each constraint into its lane.
-impl LaneSource for Preparer<'_> {
-    #[inline(always)]
-    fn lane(
-        &self,
-        k: usize,
-        w: &mut WideConstraint,
-        l: usize,
-        _: &[SolverBody],
-        inputs: &mut RowInputs,
-    ) -> usize {
-        let mut sink = LaneSink { w, l, inputs };
-        self.make_into(k, &mut sink);
-        sink.w.lens[l] as usize
-    }
-}
-
 /// Builds the wide constraints `ws` whose lanes hold the constraints `ms` (their
-/// [`WideScratch::members`]): each lane's constraint is prepared by `src` (the soft step:
-/// a [`Preparer`], written straight into the lane; tests: [`ViaScalar`]), then
-/// [`WideConstraint::finish`] builds the rows of the four lanes at once. Each wide
-/// constraint is written only from its own lanes, so disjoint ranges can be built on
-/// different threads with the same bits.
+/// [`WideScratch::members`]) lane by lane: each lane's constraint is prepared by `src`
+/// ([`ViaScalar`]), then [`WideConstraint::finish`] builds the rows of the four lanes at
+/// once. The tests' route and the oracle of the soft step's wide build
+/// (`contact_simd_prep::build_range_wide`, which prepares the four lanes at once).
+#[cfg(test)]
 pub(crate) fn build_range(
     ws: &mut [WideConstraint],
     ms: &[[usize; LANES]],

@@ -1,13 +1,14 @@
-//! The direct lane build ([`Preparer`] as a [`LaneSource`]) against its oracle, the
-//! scalar route it replaced ([`ViaScalar`]: prepare a [`ContactConstraint`], copy it into
+//! The wide build (`contact_simd_prep`, four lanes at once) against its oracle, the
+//! scalar route ([`ViaScalar`]: prepare a [`ContactConstraint`], copy it into
 //! its lane): every field of every lane, bit for bit.
 
-use super::{build_range, ViaScalar, WideConstraint};
+use super::{build_range, ViaScalar, WideConstraint, LANES, NONE};
 use crate::body::{BodyDesc, BodyType};
 use crate::body_set::{BodyHandle, BodySet};
 use crate::contact::{ContactManifold, ContactPoint};
 use crate::integrate;
 use crate::solver::contact::{self, ContactScratch, Preparer};
+use crate::solver::contact_simd::{build_range_wide_on, Isa};
 use crate::solver::{Softness, SolverBody};
 use carom_collision::math::{Isometry, Quat, Real, Vec3};
 use carom_collision::shape::{Cuboid, Shape};
@@ -103,12 +104,16 @@ fn scene(rng: &mut Rng, n: usize, origin: Vec3) -> (BodySet, Vec<ContactManifold
     (set, manifolds)
 }
 
-/// Builds the wide constraints of `manifolds` by both routes into `direct` and `oracle`
-/// (which keep what they held before: the build overwrites in place).
+/// Builds the wide constraints of `manifolds` by both routes into `direct` (the wide
+/// build on `isa`) and `oracle` (lane by lane through scalar constraints), which keep what
+/// they held before (the build overwrites in place). The lanes are the colouring's, or
+/// `members` if given (any positions of the colour order, `NONE` anywhere).
 fn build_both(
     set: &BodySet,
     manifolds: &[ContactManifold],
     bodies: &mut Vec<SolverBody>,
+    isa: Isa,
+    members: Option<&mut dyn FnMut(usize) -> Vec<[usize; LANES]>>,
     direct: &mut Vec<WideConstraint>,
     oracle: &mut Vec<WideConstraint>,
 ) {
@@ -137,7 +142,10 @@ fn build_both(
         impulse_in: 0.5,
         soft,
     };
-    let members = &scratch.wide.members;
+    let members = match members {
+        Some(f) => f(scratch.colouring.order.len()),
+        None => scratch.wide.members.clone(),
+    };
     assert!(!members.is_empty());
     for ws in [&mut *direct, &mut *oracle] {
         if ws.len() < members.len() {
@@ -145,13 +153,27 @@ fn build_both(
         }
     }
     let n = members.len();
-    build_range(&mut direct[..n], members, bodies, &p);
+    build_range_wide_on(isa, &mut direct[..n], &members, &p);
     let make = |k: usize, c: &mut contact::ContactConstraint, rows: bool| p.make(k, c, rows);
-    build_range(&mut oracle[..n], members, bodies, &ViaScalar(make));
+    build_range(&mut oracle[..n], &members, bodies, &ViaScalar(make));
+}
+
+/// Every field of every lane (stale points beyond `len` included) of `direct` equals
+/// `oracle`'s.
+fn same(direct: &[WideConstraint], oracle: &[WideConstraint], what: &str) {
+    assert_eq!(direct.len(), oracle.len());
+    for (i, (d, o)) in direct.iter().zip(oracle).enumerate() {
+        // Debug prints each float's shortest round-trip form, signed zeros included.
+        assert_eq!(
+            format!("{d:?}"),
+            format!("{o:?}"),
+            "{what}: wide constraint {i}"
+        );
+    }
 }
 
 #[test]
-fn direct_lanes_equal_the_scalar_route_bit_for_bit() {
+fn wide_build_equals_the_scalar_route_bit_for_bit() {
     let mut rng = Rng(0x9e37_79b9_7f4a_7c15);
     let (mut bodies, mut direct, mut oracle) = (Vec::new(), Vec::new(), Vec::new());
     // Near and far from the origin; the second and third builds overwrite the first's
@@ -162,10 +184,68 @@ fn direct_lanes_equal_the_scalar_route_bit_for_bit() {
         Vec3::new(-3.0, 0.0, 7.0),
     ] {
         let (set, manifolds) = scene(&mut rng, 24, origin);
-        build_both(&set, &manifolds, &mut bodies, &mut direct, &mut oracle);
-        for (i, (d, o)) in direct.iter().zip(&oracle).enumerate() {
-            // Debug prints each float's shortest round-trip form, signed zeros included.
-            assert_eq!(format!("{d:?}"), format!("{o:?}"), "wide constraint {i}");
+        let isa = Isa::detect();
+        build_both(
+            &set,
+            &manifolds,
+            &mut bodies,
+            isa,
+            None,
+            &mut direct,
+            &mut oracle,
+        );
+        same(&direct, &oracle, "colouring's lanes");
+    }
+}
+
+/// The wide build on every instruction set the CPU has, with lanes drawn at random: padding
+/// lanes anywhere (the first lane, all four), lanes of one to four points side by side,
+/// static and kinematic bodies (zero inverse masses), near and far from the origin.
+#[test]
+fn every_instruction_set_builds_the_scalar_bits() {
+    let best = Isa::detect();
+    let isas = [Isa::Base, Isa::Avx, Isa::Avx512]
+        .into_iter()
+        .filter(|&i| i == Isa::Base || i == best || (i == Isa::Avx && best == Isa::Avx512));
+    for isa in isas {
+        let mut rng = Rng(0x2545_f491_4f6c_dd1d);
+        let (mut bodies, mut direct, mut oracle) = (Vec::new(), Vec::new(), Vec::new());
+        for origin in [Vec3::ZERO, Vec3::new(-4e3, 1e3, 3e4)] {
+            let (set, manifolds) = scene(&mut rng, 16, origin);
+            let mut pick = Rng(rng.0 ^ 0x5555);
+            let mut members = |n: usize| {
+                let mut ms: Vec<[usize; LANES]> = (0..3 * n)
+                    .map(|i| {
+                        std::array::from_fn(|l| {
+                            let k = (pick.unit() * n as Real) as usize % n;
+                            // Every fifth lane and the whole fourth group are padding.
+                            if i % 4 == 3 && i % 8 == 3 || (i + l) % 5 == 0 {
+                                NONE
+                            } else {
+                                k
+                            }
+                        })
+                    })
+                    .collect();
+                ms.push([NONE; LANES]);
+                ms
+            };
+            build_both(
+                &set,
+                &manifolds,
+                &mut bodies,
+                isa,
+                Some(&mut members),
+                &mut direct,
+                &mut oracle,
+            );
+            same(&direct, &oracle, &format!("{isa:?}"));
+            // The lanes did mix point counts and padding.
+            let mixed = direct.iter().any(|w| {
+                let lens = w.lens;
+                lens.contains(&0) && lens.contains(&1) && lens.contains(&4)
+            });
+            assert!(mixed, "no group mixes padding, one and four points");
         }
     }
 }

@@ -506,7 +506,7 @@ impl Shared<'_> {
         assert!(range.end <= self.n_wide && range.end <= self.members.len());
         let p = self.preparer();
         let ws = std::slice::from_raw_parts_mut(self.wide.add(range.start), range.len());
-        contact_simd::build_range(ws, &self.members[range], p.bodies, &p);
+        contact_simd::build_range_wide(ws, &self.members[range], &p);
     }
 
     /// Builds the scalar constraints of the overflow colour (one block).
