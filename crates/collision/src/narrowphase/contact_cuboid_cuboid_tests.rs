@@ -374,3 +374,88 @@ fn clip_matches_the_polyhedron_clipper_in_order() {
     }
     assert!(compared > 10000, "{compared}");
 }
+
+/// The face preference ([`EDGE_TOL`]) keeps both kinds of contact right: a box resting on
+/// another's face, turned about the face normal (its edge axes are then that normal up to
+/// round-off, and without the tolerance an edge axis wins some of these cases by round-off),
+/// gets face points with the face normal and the exact depth, near the origin and 1 km out;
+/// two edges that really cross, touching or up to 10 cm deep, still get the one edge point.
+#[test]
+fn resting_faces_take_the_face_axis_and_crossing_edges_the_edge() {
+    let mut seed = 0x00fa_ce0f_edc3_u64;
+    let mut rnd = || {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        (seed >> 11) as Real / (1u64 << 53) as Real
+    };
+    let cuboid = |h: Vec3| crate::shape::Cuboid::new(h).unwrap();
+    let mut edge_wins_without = 0;
+    for case in 0..4000 {
+        let far = if case % 4 == 0 { 1000.0 } else { 0.0 };
+        let (ha, hb) = (
+            Vec3::new(0.5 + rnd(), 0.1 + rnd(), 0.5 + rnd()),
+            Vec3::new(0.1 + rnd(), 0.1 + rnd(), 0.1 + rnd()),
+        );
+        let depth = 0.01 * rnd();
+        let (a, b) = (cuboid(ha), cuboid(hb));
+        // B on A's top face, turned about Y, placed over the face; the world poses 1 km out
+        // in every fourth case (their relative pose carries that round-off).
+        let local = Isometry::new(
+            Vec3::new(
+                (rnd() - 0.5) * ha.x,
+                ha.y + hb.y - depth,
+                (rnd() - 0.5) * ha.z,
+            ),
+            Quat::from_rotation_y(rnd() * 6.3),
+        );
+        let wa = Isometry::new(Vec3::splat(far), Quat::from_rotation_z(0.2 * rnd()));
+        let pose = wa.inv_mul(&wa.mul(&local));
+        let rot = pose.rotation_matrix();
+        let exact = cuboid_cuboid_axis_or_separation_mat(&a, &b, &rot, pose.translation, 0.02, 0.0);
+        edge_wins_without += matches!(exact, Ok((_, _, Axis::Edge(..)))) as usize;
+        let mut out = Vec::new();
+        cuboid_cuboid_manifold_into(&a, &b, &pose, 0.02, &mut out);
+        assert!(!out.is_empty(), "case {case}");
+        let tol = 1e-4 * (1.0 + far);
+        for (c, id) in &out {
+            assert_ne!(*id, EPA_FEATURE, "case {case}: an edge point");
+            assert!((c.normal - Vec3::Y).length() <= 1e-5, "case {case}: {c:?}");
+            assert!(
+                (c.distance + depth).abs() <= tol,
+                "case {case}: {c:?} {depth}"
+            );
+        }
+    }
+    assert!(
+        edge_wins_without > 0,
+        "no case where an edge won by round-off"
+    );
+
+    // Two cubes' edges crossing at right angles, 1 cm deep: A turned 45° about Z (its top
+    // is an edge along Z), B turned 45° about X (its bottom is an edge along X).
+    let s = (2.0 as Real).sqrt();
+    let unit = cuboid(Vec3::ONE);
+    for depth in [0.0 as Real, 0.01, 0.1] {
+        let wa = Isometry::new(
+            Vec3::ZERO,
+            Quat::from_rotation_z(std::f64::consts::FRAC_PI_4 as Real),
+        );
+        let wb = Isometry::new(
+            Vec3::new(0.0, 2.0 * s - depth, 0.0),
+            Quat::from_rotation_x(std::f64::consts::FRAC_PI_4 as Real),
+        );
+        let pose = wa.inv_mul(&wb);
+        let mut out = Vec::new();
+        cuboid_cuboid_manifold_into(&unit, &unit, &pose, 0.02, &mut out);
+        assert_eq!(out.len(), 1, "depth {depth}: {out:?}");
+        let (c, id) = out[0];
+        assert_eq!(id, EPA_FEATURE, "depth {depth}");
+        let world_normal = wa.rotation * c.normal;
+        assert!(
+            (world_normal - Vec3::Y).length() <= 1e-5,
+            "depth {depth}: {c:?}"
+        );
+        assert!((c.distance + depth).abs() <= 1e-5, "depth {depth}: {c:?}");
+    }
+}
