@@ -264,7 +264,7 @@ fn queries_reject_bad_input_and_handle_an_empty_world() {
 #[test]
 fn cached_query_trees_answer_like_fresh_ones() {
     // The world keeps its query tree between calls: reused when no box changed, refitted
-    // when boxes moved, rebuilt every few refits or when the bodies change. A clone starts
+    // when boxes moved, rebuilt when its node area has grown or when the bodies change. A clone starts
     // without a cache and builds afresh; over 24 steps of falling bodies, with a body removed
     // and one added on the way, both answer every ray and shape cast identically, and the
     // hits match the brute force.

@@ -340,6 +340,25 @@ impl Bvh {
         Ok(())
     }
 
+    /// The sum of the surface areas of every node's box (as stored: quantised boxes widened
+    /// to the grid): the surface area heuristic's cost of the tree up to its leaf terms,
+    /// which depend only on the topology. A tree [`Bvh::refit`] to moved boxes keeps its
+    /// topology, and this sum tells how much worse its boxes have become than those of the
+    /// build (MacDonald and Booth 1990; Wald, Boulos and Shirley 2007 rebuild a refitted
+    /// tree when it grows too much). Zero for a tree of points.
+    pub fn node_area(&self) -> Real {
+        match &self.nodes {
+            Nodes::Quantized(v, q) => v
+                .iter()
+                .map(|n| q.dequantize(n.min, n.max).surface_area())
+                .sum(),
+            Nodes::Unquantized(v) => v
+                .iter()
+                .map(|n| Aabb::new(Vec3::from(n.min), Vec3::from(n.max)).surface_area())
+                .sum(),
+        }
+    }
+
     /// Checks this hierarchy against the primitive boxes it should bound (used when a mesh
     /// is deserialised): one primitive per box, `order` a permutation, finite bounds equal to
     /// the union of the boxes, the leaves covering `order` in depth-first sequence (each
@@ -509,6 +528,34 @@ mod tests {
     #[test]
     fn node_sizes() {
         assert_eq!(std::mem::size_of::<QuantizedNode>(), 16);
+    }
+
+    /// `node_area` against the node boxes as `node_boxes_and_data` decodes them, on both
+    /// layouts: one box (the root is the leaf), 200 scattered boxes with internal nodes, and
+    /// a tree of points (zero up to the quantisation's widening).
+    #[test]
+    fn node_area_sums_the_node_boxes() {
+        let a = Aabb::new(Vec3::ZERO, Vec3::new(1.0, 2.0, 3.0));
+        let scattered: Vec<Aabb> = (0..200)
+            .map(|i| {
+                let c = Vec3::new((i * 7 % 23) as Real, (i * 5 % 11) as Real, (i % 13) as Real);
+                Aabb::new(c, c + Vec3::new(0.5, 1.0 + (i % 3) as Real, 0.25))
+            })
+            .collect();
+        let p = Aabb::new(Vec3::ONE, Vec3::ONE);
+        for layout in [BvhLayout::Quantized, BvhLayout::Unquantized] {
+            let one = Bvh::new(&[a], layout).unwrap();
+            assert!((one.node_area() - 22.0).abs() <= 1e-3 * 22.0, "{layout:?}");
+            let many = Bvh::new(&scattered, layout).unwrap();
+            let (boxes, _) = many.node_boxes_and_data();
+            assert!(boxes.len() > 3, "{layout:?}");
+            let want: Real = boxes.iter().map(Aabb::surface_area).sum();
+            assert_eq!(many.node_area(), want, "{layout:?}");
+            assert!(want > many.bounds.surface_area(), "{layout:?}");
+            // Zero, but for the quantisation's widening of a point by round-off.
+            let points = Bvh::new(&[p, p, p], layout).unwrap().node_area();
+            assert!((0.0..=1e-9).contains(&points), "{layout:?}: {points}");
+        }
     }
 
     #[test]

@@ -13,11 +13,14 @@
 //!
 //! The world keeps the tree between queries ([`QueryCache`]): when the same bodies are
 //! queried again, it is reused as is if no box changed, refitted to the new boxes otherwise
-//! (`Bvh::refit`, about a fifth of a build's instructions for 1000 bodies), and rebuilt
-//! after [`QueryCache::REFITS_PER_BUILD`] refits so the topology follows bodies that move
-//! far (Bullet's `btDbvt` refits and re-inserts for the same reason). Results do not
-//! depend on the topology (closest hit, ties to the lower body slot), so a refitted tree
-//! answers exactly what a fresh one would.
+//! (`Bvh::refit`, about a seventieth of a build's instructions for 1000 bodies), and
+//! rebuilt when the refitted tree's node area (`Bvh::node_area`, the surface area
+//! heuristic's cost for a fixed topology) has grown past [`QueryCache::REBUILD_GROWTH`]
+//! times the area it had when built, so the topology follows bodies that move far (Bullet's
+//! `btDbvt` refits and re-inserts for the same reason) while a settled scene keeps its tree.
+//! (It rebuilt after every eight refits before: in "raytests" the rebuilds were half the
+//! 500-ray batch's instructions.) Results do not depend on the topology (closest hit, ties
+//! to the lower body slot), so a refitted tree answers exactly what a fresh one would.
 //!
 //! Poses are the bodies' current poses (what [`World::bodies`] reports, including teleports
 //! since the last step), not the collision objects' poses of the last step.
@@ -57,8 +60,9 @@ pub struct BodyShapeCastHit {
 pub struct WorldQuery<'w> {
     objects: Vec<(BodyHandle, &'w Shape, Isometry, Filter)>,
     bvh: Option<Bvh>,
-    /// Where the tree goes back when the query is dropped, with the boxes it was fitted to.
-    cache: Option<(&'w QueryCache, Vec<Aabb>, u32)>,
+    /// Where the tree goes back when the query is dropped, with the boxes it was fitted to
+    /// and its node area when built.
+    cache: Option<(&'w QueryCache, Vec<Aabb>, Real)>,
 }
 
 /// The tree of the last [`World::query`], kept for the next one (see the module docs).
@@ -68,46 +72,50 @@ pub(crate) struct QueryCache {
     slot: Mutex<Option<CachedTree>>,
 }
 
-/// A tree with the bodies and boxes it was fitted to, and the refits since its build.
+/// A tree with the bodies and boxes it was fitted to, and its node area when built.
 struct CachedTree {
     bvh: Bvh,
     bodies: Vec<BodyHandle>,
     boxes: Vec<Aabb>,
-    refits: u32,
+    built_area: Real,
 }
 
 impl QueryCache {
-    /// Refits of a cached tree before the next query rebuilds it.
-    pub const REFITS_PER_BUILD: u32 = 8;
+    /// How much a refitted tree's node area may grow over its build's before the next query
+    /// rebuilds it.
+    pub const REBUILD_GROWTH: Real = 1.25;
 
-    /// The tree over `boxes` (of `bodies`, in this order) and its refit count: the cached
-    /// one reused or refitted when it covers the same bodies, a new one otherwise.
-    fn tree_for(&self, bodies: &[BodyHandle], boxes: &[Aabb]) -> Result<(Bvh, u32)> {
+    /// The tree over `boxes` (of `bodies`, in this order) and its node area when built: the
+    /// cached one reused or refitted when it covers the same bodies and has not grown too
+    /// much, a new one otherwise.
+    fn tree_for(&self, bodies: &[BodyHandle], boxes: &[Aabb]) -> Result<(Bvh, Real)> {
         // A poisoned lock (a panic elsewhere while it was held) only loses the cache.
         let cached = self.slot.lock().ok().and_then(|mut g| g.take());
         if let Some(c) = cached {
             if c.bodies == bodies {
                 if c.boxes == boxes {
-                    return Ok((c.bvh, c.refits));
+                    return Ok((c.bvh, c.built_area));
                 }
-                if c.refits < Self::REFITS_PER_BUILD {
-                    let mut bvh = c.bvh;
-                    bvh.refit(boxes)?;
-                    return Ok((bvh, c.refits + 1));
+                let mut bvh = c.bvh;
+                bvh.refit(boxes)?;
+                if bvh.node_area() <= Self::REBUILD_GROWTH * c.built_area {
+                    return Ok((bvh, c.built_area));
                 }
             }
         }
-        Ok((Bvh::new(boxes, BvhLayout::default())?, 0))
+        let bvh = Bvh::new(boxes, BvhLayout::default())?;
+        let area = bvh.node_area();
+        Ok((bvh, area))
     }
 
     /// Keeps `bvh` for the next query.
-    fn put(&self, bvh: Bvh, bodies: Vec<BodyHandle>, boxes: Vec<Aabb>, refits: u32) {
+    fn put(&self, bvh: Bvh, bodies: Vec<BodyHandle>, boxes: Vec<Aabb>, built_area: Real) {
         if let Ok(mut g) = self.slot.lock() {
             *g = Some(CachedTree {
                 bvh,
                 bodies,
                 boxes,
-                refits,
+                built_area,
             });
         }
     }
@@ -130,9 +138,9 @@ impl std::fmt::Debug for QueryCache {
 
 impl Drop for WorldQuery<'_> {
     fn drop(&mut self) {
-        if let (Some(bvh), Some((cache, boxes, refits))) = (self.bvh.take(), self.cache.take()) {
+        if let (Some(bvh), Some((cache, boxes, area))) = (self.bvh.take(), self.cache.take()) {
             let bodies = self.objects.iter().map(|o| o.0).collect();
-            cache.put(bvh, bodies, boxes, refits);
+            cache.put(bvh, bodies, boxes, area);
         }
     }
 }
@@ -290,8 +298,8 @@ impl World {
     /// [`crate::pipeline::queries`]).
     pub fn query(&self) -> Result<WorldQuery<'_>> {
         let set = self.bodies();
-        let mut objects = Vec::new();
-        let mut boxes = Vec::new();
+        let n = self.collision.len();
+        let (mut objects, mut boxes) = (Vec::with_capacity(n), Vec::with_capacity(n));
         for (h, o) in self.collision.iter() {
             let Some(body) = self.body_of_object(h) else {
                 continue;
@@ -314,11 +322,11 @@ impl World {
             });
         }
         let bodies: Vec<BodyHandle> = objects.iter().map(|o| o.0).collect();
-        let (bvh, refits) = self.query_cache.tree_for(&bodies, &boxes)?;
+        let (bvh, area) = self.query_cache.tree_for(&bodies, &boxes)?;
         Ok(WorldQuery {
             objects,
             bvh: Some(bvh),
-            cache: Some((&self.query_cache, boxes, refits)),
+            cache: Some((&self.query_cache, boxes, area)),
         })
     }
 
@@ -357,5 +365,86 @@ impl World {
     ) -> Result<Option<BodyShapeCastHit>> {
         self.query()?
             .shape_cast(shape, pose, velocity, max_time, mask)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Unit boxes on a 10 × 10 grid, 3 m apart, each moved by `offset(i)`.
+    fn grid(offset: impl Fn(usize) -> Vec3) -> Vec<Aabb> {
+        (0..100)
+            .map(|i| {
+                let c = Vec3::new((i % 10) as Real * 3.0, 0.0, (i / 10) as Real * 3.0) + offset(i);
+                Aabb::new(c - Vec3::splat(0.5), c + Vec3::splat(0.5))
+            })
+            .collect()
+    }
+
+    /// The cache's rebuild rule: a tree whose boxes jitter is refitted and keeps its build's
+    /// area; one whose boxes swap places across the grid (same bounds, crossing subtrees) has
+    /// grown past `REBUILD_GROWTH` and is rebuilt, with the area of a fresh build; new bodies
+    /// rebuild too. Every tree the cache hands out bounds its boxes as a fresh one does.
+    #[test]
+    fn refitted_trees_are_rebuilt_when_their_area_grows() {
+        let cache = QueryCache::default();
+        let bodies: Vec<BodyHandle> = (0..100)
+            .map(|i| BodyHandle {
+                index: i,
+                generation: 0,
+            })
+            .collect();
+        let put = |bvh: Bvh, boxes: &[Aabb], area: Real| {
+            cache.put(bvh, bodies.clone(), boxes.to_vec(), area)
+        };
+        let fresh_area =
+            |boxes: &[Aabb]| Bvh::new(boxes, BvhLayout::default()).unwrap().node_area();
+        let first = grid(|_| Vec3::ZERO);
+        let (bvh, built) = cache.tree_for(&bodies, &first).unwrap();
+        assert_eq!(built, fresh_area(&first));
+        put(bvh, &first, built);
+
+        // Jitter of 2 cm: refitted, the build's area kept, the tree bounds the new boxes.
+        let jitter = grid(|i| Vec3::new(0.02 * (i % 3) as Real, 0.01, -0.02 * (i % 2) as Real));
+        let (bvh, area) = cache.tree_for(&bodies, &jitter).unwrap();
+        assert_eq!(area, built, "a jittered tree was rebuilt");
+        assert!(bvh.node_area() <= QueryCache::REBUILD_GROWTH * built);
+        let mut seen = [false; 100];
+        for (i, b) in jitter.iter().enumerate() {
+            bvh.for_each_candidate_on_ray(b.center() - Vec3::Y * 5.0, Vec3::Y, 10.0, |p, _| {
+                seen[i] |= p as usize == i;
+                true
+            });
+        }
+        assert!(seen.iter().all(|&s| s), "a refitted tree lost a box");
+        put(bvh, &jitter, area);
+
+        // Boxes scrambled across the grid (box i takes the place of 37 i mod 100): the same
+        // bounds, but every subtree now spans the grid; rebuilt.
+        let swapped = grid(|i| {
+            let j = (37 * i) % 100;
+            Vec3::new(
+                (j % 10) as Real * 3.0 - (i % 10) as Real * 3.0,
+                0.0,
+                (j / 10) as Real * 3.0 - (i / 10) as Real * 3.0,
+            )
+        });
+        let (bvh, area) = cache.tree_for(&bodies, &swapped).unwrap();
+        assert_eq!(area, fresh_area(&swapped), "a scrambled tree was kept");
+        assert_eq!(bvh.node_area(), area);
+        put(bvh, &swapped, area);
+
+        // Other bodies: rebuilt even with the same boxes.
+        let others: Vec<BodyHandle> = bodies
+            .iter()
+            .map(|h| BodyHandle {
+                index: h.index,
+                generation: 1,
+            })
+            .collect();
+        let (bvh, area) = cache.tree_for(&others, &swapped).unwrap();
+        assert_eq!(area, fresh_area(&swapped));
+        assert_eq!(bvh.node_area(), area);
     }
 }
