@@ -31,12 +31,6 @@ use crate::shape::{ConvexRef, Cuboid};
 /// as faces (about 2.6°, as the guided polyhedron path).
 const FACE_COS: Real = 0.999;
 
-/// How much less than the least face overlap an edge axis' overlap must be for the
-/// manifold to take it, relative to the boxes' size (the sum of their largest half
-/// extents): 2·10⁻⁴ m for two 2 m cubes. Resting faces give edge axes equal to the face
-/// normal up to round-off; an edge that wins by less changes the depth by less than this.
-const EDGE_TOL: Real = 1.0e-4;
-
 /// The full manifold of box `x` against box `y` (at `pose_ab` in A's frame), appended to
 /// `out` in A's frame with the query convention (normal from A towards B): up to 8 clipped
 /// points (the persistent manifold reduces them to 4), or one edge point, or nothing when
@@ -66,9 +60,7 @@ pub fn cuboid_cuboid_manifold_or_separation(
     // B's rotation in A's frame, once for the separating-axis test and the clipping (each
     // built it from the quaternion before; the same bits).
     let rot = pose_ab.rotation_matrix();
-    let edge_tol = EDGE_TOL * (x.half_extents().max_element() + y.half_extents().max_element());
-    let sat =
-        cuboid_cuboid_axis_or_separation_mat(x, y, &rot, pose_ab.translation, prediction, edge_tol);
+    let sat = cuboid_cuboid_axis_or_separation_mat(x, y, &rot, pose_ab.translation, prediction);
     let (overlap, n, axis) = match sat {
         Ok(found) => found,
         Err((distance, axis)) => {

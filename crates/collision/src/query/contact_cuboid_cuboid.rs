@@ -349,7 +349,7 @@ pub fn cuboid_cuboid_axis_or_separation(
     prediction: Real,
 ) -> Result<(Real, Vec3, Axis), (Real, Vec3)> {
     let rot = pose_ab.rotation_matrix();
-    cuboid_cuboid_axis_or_separation_mat(a, b, &rot, pose_ab.translation, prediction, 0.0)
+    cuboid_cuboid_axis_or_separation_mat(a, b, &rot, pose_ab.translation, prediction)
 }
 
 /// [`cuboid_cuboid_axis_or_separation`] with B's rotation matrix in A's frame
@@ -369,13 +369,6 @@ pub fn cuboid_cuboid_axis_or_separation(
 /// (Bullet's `dBoxBox2` and parry's `cuboid_cuboid_find_local_separating_edge_twoway` also
 /// test the edge axes without normalising the ones that cannot win; here every edge axis is
 /// divided by its length, three at a time, to keep the scalar test's bits.)
-///
-/// `edge_tol` (0 for the exact answer) lets an overlapping edge axis win only when its
-/// overlap is less than the least face overlap by more than `edge_tol`: the manifold's face
-/// preference (Gregorius, "The Separating Axis Test between Convex Polyhedra", GDC 2013, and
-/// Box2D/Box3D's relative tolerance). Two boxes resting face on face have edge axes equal to
-/// the face normal up to round-off, which won about a third of the overlapping tests of
-/// "3000 fall" and paid for an edge witness before clipping the same faces.
 #[inline]
 pub(crate) fn cuboid_cuboid_axis_or_separation_mat(
     a: &Cuboid,
@@ -383,7 +376,6 @@ pub(crate) fn cuboid_cuboid_axis_or_separation_mat(
     rot: &Mat3,
     t: Vec3,
     prediction: Real,
-    edge_tol: Real,
 ) -> Result<(Real, Vec3, Axis), (Real, Vec3)> {
     let (ha, hb) = (va(a.half_extents()), va(b.half_extents()));
     let hb_s = b.half_extents().to_array();
@@ -495,8 +487,7 @@ pub(crate) fn cuboid_cuboid_axis_or_separation_mat(
     }
     let [m0, m1, m2] = over_m;
     let m = m0.min(m1).min(m2).min_element();
-    // `best - 0` is `best`: with no tolerance, the scalar test's strict `<`.
-    if m < best - edge_tol {
+    if m < best {
         let ms = Vec3A::splat(m);
         let eq = in_order([
             m0.cmpeq(ms).bitmask(),

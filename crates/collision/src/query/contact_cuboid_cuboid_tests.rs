@@ -97,14 +97,8 @@ fn unrolled_sat_matches_the_loop_bit_for_bit() {
         let rot_m = pose.rotation_matrix();
         for prediction in [0.0 as Real, 0.02, 5.0] {
             let want = axis_reference(&a, &b, &pose, prediction);
-            let got = cuboid_cuboid_axis_or_separation_mat(
-                &a,
-                &b,
-                &rot_m,
-                pose.translation,
-                prediction,
-                0.0,
-            );
+            let got =
+                cuboid_cuboid_axis_or_separation_mat(&a, &b, &rot_m, pose.translation, prediction);
             match (got, want) {
                 (Ok((go, gn, gk)), Ok((wo, wn, wk))) => {
                     assert_eq!((go.to_bits(), bits(gn), gk), (wo.to_bits(), bits(wn), wk));
@@ -138,7 +132,6 @@ fn unrolled_sat_matches_the_loop_bit_for_bit() {
         &pose.rotation_matrix(),
         pose.translation,
         0.02,
-        0.0,
     );
     assert!(matches!(got, Err((d, _)) if d.is_nan()));
     assert!(matches!(axis_reference(&a, &b, &pose, 0.02), Err((d, _)) if d.is_nan()));
