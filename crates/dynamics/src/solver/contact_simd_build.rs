@@ -98,9 +98,9 @@ fn mat_mul(m: &[[W; 3]; 3], v: V3) -> V3 {
     }
 }
 
-/// Lanes of `v` where `mask` is set, zero elsewhere.
+/// Lanes of `v` where `mask` is set, `+0.0` elsewhere.
 #[inline(always)]
-fn keep(mask: W, v: V3) -> V3 {
+pub(super) fn keep(mask: W, v: V3) -> V3 {
     let zero = W::splat(0.0);
     V3 {
         x: mask.select(v.x, zero),

@@ -10,7 +10,7 @@
 //! multiply-add), so each lane has the bits of the scalar preparation; lanes without a
 //! point or without a constraint are masked to the zeros the scalar route writes there.
 
-use super::build::{lane_index, RowInputs};
+use super::build::{keep, lane_index, RowInputs};
 use super::run::Isa;
 use super::{WideConstraint, WidePoint, LANES, NONE, NO_SLOT, V3, W};
 use crate::contact::{ContactManifold, ContactPoint};
@@ -32,17 +32,6 @@ fn lanes3(f: impl Fn(usize) -> Vec3) -> V3 {
         x: W::from([v[0].x, v[1].x, v[2].x, v[3].x]),
         y: W::from([v[0].y, v[1].y, v[2].y, v[3].y]),
         z: W::from([v[0].z, v[1].z, v[2].z, v[3].z]),
-    }
-}
-
-/// Lanes of `v` where `mask` is set, `+0.0` elsewhere.
-#[inline(always)]
-fn keep(mask: W, v: V3) -> V3 {
-    let zero = W::splat(0.0);
-    V3 {
-        x: mask.select(v.x, zero),
-        y: mask.select(v.y, zero),
-        z: mask.select(v.z, zero),
     }
 }
 

@@ -232,6 +232,16 @@ impl Isa {
         }
         Isa::Base
     }
+
+    /// Every instruction set this CPU can run, the baseline first (the tests run each).
+    #[cfg(test)]
+    pub(crate) fn available() -> Vec<Isa> {
+        let best = Isa::detect();
+        [Isa::Base, Isa::Avx, Isa::Avx512]
+            .into_iter()
+            .filter(|&i| i == Isa::Base || i == best || (i == Isa::Avx && best == Isa::Avx512))
+            .collect()
+    }
 }
 
 /// Runs `f` (where `active` holds) on the wide constraints `range` of `cons`, one after
