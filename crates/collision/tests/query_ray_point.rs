@@ -9,7 +9,7 @@ use carom_collision::math::{Isometry, Real, Vec3};
 use carom_collision::query::point::project_convex_gjk;
 use carom_collision::query::ray::analytic::ray_hull;
 use carom_collision::query::ray::raycast_convex_gjk;
-use carom_collision::query::{project_point, raycast, Ray};
+use carom_collision::query::{project_point, raycast, raycast_local, Ray};
 use carom_collision::shape::{Capsule, Cone, Cuboid, Cylinder, Plane, Shape, Sphere, Triangle};
 use common::*;
 use std::sync::Arc;
@@ -346,4 +346,78 @@ fn hull_point_distance_matches_triangle_enumeration() {
             "{pr:?} vs {want}"
         );
     }
+}
+
+/// Solid casts on hulls take a shortcut (`ray_hull_solid`: a box test first, the exit
+/// clamped to the bound); every result must be the one read from the full face-plane
+/// interval (`ray_hull`), bit for bit: rays from inside and outside, aimed at vertices
+/// (the hull's box touches them) and along face planes, near the origin and 10 km out,
+/// with bounds of zero, short of, at and past the hit, and infinite.
+#[test]
+fn solid_hull_casts_equal_the_full_interval() {
+    let mut rng = Rng(41);
+    let (mut hits, mut inside_hits) = (0, 0);
+    for case in 0..3000 {
+        let h = random_hull(&mut rng, 6 + case % 20, 1.0);
+        let far = if case % 3 == 0 { 1.0e4 } else { 0.0 };
+        let verts = h.vertices().to_vec();
+        let shape = Shape::ConvexHull(h);
+        let Shape::ConvexHull(h) = &shape else {
+            unreachable!()
+        };
+        let offset = Vec3::splat(far);
+        let (o, target) = match case % 4 {
+            // At a vertex, from outside.
+            0 => (rng.unit() * 3.0, verts[case % verts.len()]),
+            // From inside.
+            1 => (rng.vec(0.2), rng.unit() * 3.0),
+            // Along a face plane: from a vertex towards another on the same face.
+            2 => {
+                let f = case % h.faces().len();
+                let idx = h.face_vertices(f);
+                let (a, b) = (verts[idx[0] as usize], verts[idx[1] as usize]);
+                (a - (b - a) * 2.0, b)
+            }
+            _ => (rng.unit() * 3.0, rng.vec(1.2)),
+        };
+        let Ok(ray) = Ray::new(o + offset, target - o) else {
+            continue;
+        };
+        // The local frame is the hull's: move the hull by the offset instead of the ray.
+        let local = Ray {
+            origin: ray.origin - offset,
+            dir: ray.dir,
+        };
+        let full = ray_hull(local.origin, local.dir, h);
+        let t_hit = full.map_or(1.0, |i| i.t0.max(0.0));
+        for max in [0.0, 0.5 * t_hit, t_hit, 2.0 * t_hit + 1.0, Real::INFINITY] {
+            let got = raycast_local(&shape, &local, max, true);
+            let want = full.and_then(|i| {
+                if i.t1 < 0.0 {
+                    return None;
+                }
+                let (t, n, inside) = if i.t0 >= 0.0 {
+                    (i.t0, i.n0, false)
+                } else {
+                    (0.0, -local.dir, true)
+                };
+                (t <= max).then(|| (t, n.normalize_or(-local.dir.normalize_or_zero()), inside))
+            });
+            match (got, want) {
+                (None, None) => {}
+                (Some(g), Some((t, n, inside))) => {
+                    assert_eq!(g.distance.to_bits(), t.to_bits(), "case {case}, max {max}");
+                    assert_eq!(g.normal, n, "case {case}, max {max}");
+                    assert_eq!(g.inside, inside, "case {case}");
+                    hits += 1;
+                    inside_hits += usize::from(inside);
+                }
+                (g, w) => panic!("case {case}, max {max}: {g:?} vs full interval {w:?}"),
+            }
+        }
+    }
+    assert!(
+        hits > 3000 && inside_hits > 500,
+        "{hits} hits, {inside_hits} inside"
+    );
 }

@@ -45,7 +45,7 @@ pub use contact_convex::{contact_convex, distance_convex, intersects_convex};
 pub mod contact;
 pub use contact::{contact, contact_local, distance, intersects};
 pub mod ray;
-pub use ray::{raycast, raycast_local, Ray};
+pub use ray::{raycast, raycast_local, raycast_ray, Ray};
 pub mod point;
 pub use point::{contains_point, project_point, project_point_local};
 pub mod shape_cast;

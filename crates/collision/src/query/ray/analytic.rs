@@ -241,7 +241,12 @@ pub fn ray_plane(o: Vec3, d: Vec3, p: &Plane) -> Option<Interval> {
 
 /// Convex hull: clip against every face plane.
 pub fn ray_hull(o: Vec3, d: Vec3, h: &ConvexHull) -> Option<Interval> {
-    let mut i = Interval::ALL;
+    clip_by_faces(o, d, h, Interval::ALL)
+}
+
+/// Narrows `i` by every face plane of `h` (Cyrus–Beck), `None` once it is empty.
+#[inline]
+fn clip_by_faces(o: Vec3, d: Vec3, h: &ConvexHull, mut i: Interval) -> Option<Interval> {
     for f in h.faces() {
         let dn = f.normal.dot(d);
         let gap = f.offset - f.normal.dot(o);
@@ -266,6 +271,27 @@ pub fn ray_hull(o: Vec3, d: Vec3, h: &ConvexHull) -> Option<Interval> {
         }
     }
     Some(i)
+}
+
+/// [`ray_hull`] for a solid cast up to `max_t` (>= 0, may be infinite), which reads only the
+/// entry of the interval and whether its exit is behind the origin: a ray that misses the
+/// hull's local box (inflated by a rounding margin, so the test only rejects clear misses)
+/// is rejected before any face, and the exit starts at `max_t`, so the face loop stops as
+/// soon as the entry passes it. The entry, its normal and the hit or miss are those of
+/// [`ray_hull`] for every ray a solid cast reports (the exit is `min(exit, max_t)` and its
+/// normal is not meaningful). Scene queries test many hulls whose loose world boxes the ray
+/// crosses; most are rejected by the box or by the current closest hit.
+pub fn ray_hull_solid(o: Vec3, d: Vec3, h: &ConvexHull, max_t: Real) -> Option<Interval> {
+    let b = h.local_aabb();
+    let scale = (b.max - b.min).max_element() + o.abs().max_element();
+    // Thousands of ulps: the face planes are rounded from the vertices that bound the box.
+    let margin = 1024.0 * EPSILON * scale;
+    b.expanded(margin).ray_intersection(o, d, max_t + margin)?;
+    let i = Interval {
+        t1: max_t,
+        ..Interval::ALL
+    };
+    clip_by_faces(o, d, h, i)
 }
 
 /// Two-sided triangle (Möller–Trumbore): `(t, normal facing the ray)`; `None` when
