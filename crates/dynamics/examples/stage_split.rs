@@ -1,7 +1,8 @@
-//! Mean and median wall time of every pipeline stage of one `carom-scenes` scene (sleeping off, one
-//! thread), to see where a step goes before profiling deeper.
+//! Mean and median wall time of every pipeline stage of one `carom-scenes` scene (sleeping off,
+//! one thread unless told), to see where a step goes before profiling deeper.
 //!
-//! `cargo run --release -p carom-dynamics --example stage_split -- [scene 1–8] [steps]`
+//! `cargo run --release -p carom-dynamics --example stage_split -- [scene 1–8] [steps]
+//! [threads]`
 
 use carom_dynamics::{PipelineParams, World};
 
@@ -9,10 +10,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut args = std::env::args().skip(1);
     let number: usize = args.next().and_then(|s| s.parse().ok()).unwrap_or(2);
     let steps: usize = args.next().and_then(|s| s.parse().ok()).unwrap_or(300);
+    let threads: usize = args.next().and_then(|s| s.parse().ok()).unwrap_or(1);
     let scene = carom_scenes::bullet::scene(number).ok_or("scene number must be 1–8")?;
     let mut params = PipelineParams::default();
     params.dynamics.sleep.enabled = false;
-    let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build()?;
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()?;
     let mut world = World::from_scene_with(&scene, params)?;
     let names = [
         "sync",
