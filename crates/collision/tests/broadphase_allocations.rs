@@ -1,7 +1,9 @@
 //! The two-tree broadphase allocates nothing per update in the steady state: boxes that
 //! jitter inside and out of their fat boxes (refits, queries, candidate merges, pair diffs)
-//! reuse the buffers grown during a warm-up. The hashed grid and the hierarchical grid
-//! (rebuilt from scratch at every update) reuse theirs too.
+//! reuse the buffers grown during a warm-up. The hashed grid, the hierarchical grid and the
+//! sort-and-sweep (rebuilt from scratch at every update) and the incremental sweep-and-prune
+//! reuse theirs too. (The two trees with Manhattan insertion allocate a few times in 48
+//! updates, varying from run to run; not covered here.)
 
 use carom_collision::broadphase::{
     AnyBroadPhase, BroadPhase, Filter, Method, ProxyHandle, TreeBroadPhase,
@@ -97,7 +99,7 @@ fn a_steady_tree_broadphase_update_allocates_nothing() {
 }
 
 #[test]
-fn steady_grid_updates_allocate_nothing() {
+fn steady_rebuilt_and_sweep_updates_allocate_nothing() {
     // The lattice, plus a few larger boxes (other hierarchy levels) and a huge one (the
     // oversize list). Run on a rayon worker, as the pipeline does (`pool.install`): a
     // parallel loop started from outside a pool goes through rayon's injector queue, which
@@ -106,7 +108,7 @@ fn steady_grid_updates_allocate_nothing() {
         .num_threads(2)
         .build()
         .unwrap();
-    for method in [Method::Grid, Method::HGrid] {
+    for method in [Method::Grid, Method::HGrid, Method::Sap, Method::SortSweep] {
         let mut bp = AnyBroadPhase::new(method);
         let handles: Vec<ProxyHandle> = (0..1000)
             .map(|_| {

@@ -87,6 +87,9 @@ pub struct SweepAndPrune {
     pending_add: Vec<u32>,
     removed_any: bool,
     overlaps: PairSet,
+    /// The pair keys handed to the cache at each update (it hands back its previous array):
+    /// a steady update allocates nothing.
+    pairs: Vec<u64>,
     /// Pending additions above which the lists are rebuilt from scratch.
     pub rebuild_threshold: usize,
 }
@@ -131,6 +134,7 @@ impl SweepAndPrune {
             pending_add: Vec::new(),
             removed_any: false,
             overlaps: PairSet::default(),
+            pairs: Vec::new(),
             rebuild_threshold: 64,
         }
     }
@@ -448,16 +452,17 @@ impl BroadPhase for SweepAndPrune {
         pending.clear();
         self.pending_add = pending;
         let boxes = self.store.aabbs();
-        let keys: Vec<u64> = self
-            .overlaps
-            .iter()
-            .copied()
-            .filter(|&k| {
-                let (a, b) = unpack_pair(k);
-                boxes[a as usize].intersects(&boxes[b as usize])
-            })
-            .collect();
-        self.cache.replace(&mut self.store, keys, false)
+        let mut keys = std::mem::take(&mut self.pairs);
+        keys.clear();
+        keys.extend(self.overlaps.iter().copied().filter(|&k| {
+            let (a, b) = unpack_pair(k);
+            boxes[a as usize].intersects(&boxes[b as usize])
+        }));
+        let changes = self
+            .cache
+            .replace_reusing(&mut self.store, &mut keys, false);
+        self.pairs = keys;
+        changes
     }
 
     impl_common_broadphase!();

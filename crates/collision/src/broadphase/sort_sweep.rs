@@ -7,11 +7,12 @@
 //! for each box scan forward while the next min does not exceed its max, testing the two other
 //! axes. The scan is split into fixed-size chunks run in parallel (rayon); chunk boundaries do
 //! not depend on the thread count and the pairs are sorted afterwards, so the result is the
-//! same on any number of threads. Nothing is kept between updates: cost does not depend on
-//! how far objects moved.
+//! same on any number of threads. No state is kept between updates but reused buffers, so
+//! cost does not depend on how far objects moved, and a steady update allocates nothing (up
+//! to `2 × radix::PAR_CHUNK` proxies, past which the parallel sort allocates its merge buffer).
 
 use super::impl_rebuilt_proxies;
-use super::radix::par_sort_u64;
+use super::radix::par_sort_u64_with;
 use super::{impl_common_broadphase, pair_key, BroadPhase, PairCache, PairChanges, ProxyStore};
 use crate::math::{ordered_to_real, real_floor_key, Aabb, Real, Vec3};
 
@@ -25,6 +26,21 @@ pub struct SortSweep {
     cache: PairCache,
     /// Axis used by the last update (0, 1 or 2).
     last_axis: usize,
+    /// Buffers reused by every update.
+    bufs: SweepBuffers,
+}
+
+/// Per-update buffers of the sweep, kept between updates: the live proxies, the sort keys
+/// and the sort's scratch, the boxes in sweep order, one pair list per chunk and the pair
+/// keys handed to the cache (which hands back its previous array).
+#[derive(Debug, Clone, Default)]
+struct SweepBuffers {
+    live: Vec<u32>,
+    keys: Vec<u64>,
+    scratch: Vec<u64>,
+    sorted: Sorted,
+    parts: Vec<Vec<u64>>,
+    pairs: Vec<u64>,
 }
 
 impl SortSweep {
@@ -63,6 +79,7 @@ pub fn axis_of_greatest_variance(boxes: &[Aabb], ids: &[u32]) -> usize {
 }
 
 /// Sorted sweep data: boxes in sweep order, their rounded-down min on the axis, their ids.
+#[derive(Debug, Clone, Default)]
 struct Sorted {
     boxes: Vec<Aabb>,
     lo: Vec<Real>,
@@ -93,20 +110,35 @@ fn sweep_range(s: &Sorted, axis: usize, range: std::ops::Range<usize>, out: &mut
     }
 }
 
-/// All overlapping pairs among `boxes[ids]` as unsorted pair keys (each pair once).
+/// All overlapping pairs among `boxes[ids]` as unsorted pair keys (each pair once), and the
+/// axis swept.
 pub fn find_pairs(boxes: &[Aabb], ids: &[u32]) -> (Vec<u64>, usize) {
+    let mut bufs = SweepBuffers::default();
+    let mut out = Vec::new();
+    let axis = find_pairs_into(boxes, ids, &mut bufs, &mut out);
+    (out, axis)
+}
+
+/// [`find_pairs`] into `out` (cleared first) with reused buffers; returns the axis.
+fn find_pairs_into(
+    boxes: &[Aabb],
+    ids: &[u32],
+    bufs: &mut SweepBuffers,
+    out: &mut Vec<u64>,
+) -> usize {
     let axis = axis_of_greatest_variance(boxes, ids);
-    let mut keys: Vec<u64> = ids
-        .iter()
-        .map(|&i| ((real_floor_key(boxes[i as usize].min[axis]) as u64) << 32) | i as u64)
-        .collect();
-    par_sort_u64(&mut keys);
-    let mut s = Sorted {
-        boxes: Vec::with_capacity(keys.len()),
-        lo: Vec::with_capacity(keys.len()),
-        ids: Vec::with_capacity(keys.len()),
-    };
-    for &k in &keys {
+    let keys = &mut bufs.keys;
+    keys.clear();
+    keys.extend(
+        ids.iter()
+            .map(|&i| ((real_floor_key(boxes[i as usize].min[axis]) as u64) << 32) | i as u64),
+    );
+    par_sort_u64_with(keys, &mut bufs.scratch);
+    let s = &mut bufs.sorted;
+    s.boxes.clear();
+    s.lo.clear();
+    s.ids.clear();
+    for &k in keys.iter() {
         let id = k as u32;
         s.boxes.push(boxes[id as usize]);
         s.ids.push(id);
@@ -114,37 +146,37 @@ pub fn find_pairs(boxes: &[Aabb], ids: &[u32]) -> (Vec<u64>, usize) {
     }
     let n = s.boxes.len();
     let chunks = n.div_ceil(SWEEP_CHUNK);
-    #[cfg(feature = "parallel")]
-    let parts: Vec<Vec<u64>> = {
-        use rayon::prelude::*;
-        (0..chunks)
-            .into_par_iter()
-            .map(|c| {
-                let mut out = Vec::new();
-                sweep_range(
-                    &s,
-                    axis,
-                    c * SWEEP_CHUNK..((c + 1) * SWEEP_CHUNK).min(n),
-                    &mut out,
-                );
-                out
-            })
-            .collect()
+    if bufs.parts.len() < chunks {
+        bufs.parts.resize_with(chunks, Vec::new);
+    }
+    let s = &bufs.sorted;
+    let run = |c: usize, part: &mut Vec<u64>| {
+        part.clear();
+        sweep_range(
+            s,
+            axis,
+            c * SWEEP_CHUNK..((c + 1) * SWEEP_CHUNK).min(n),
+            part,
+        );
     };
+    let parts = &mut bufs.parts[..chunks];
+    #[cfg(feature = "parallel")]
+    {
+        use rayon::prelude::*;
+        parts
+            .par_iter_mut()
+            .enumerate()
+            .for_each(|(c, part)| run(c, part));
+    }
     #[cfg(not(feature = "parallel"))]
-    let parts: Vec<Vec<u64>> = (0..chunks)
-        .map(|c| {
-            let mut out = Vec::new();
-            sweep_range(
-                &s,
-                axis,
-                c * SWEEP_CHUNK..((c + 1) * SWEEP_CHUNK).min(n),
-                &mut out,
-            );
-            out
-        })
-        .collect();
-    (parts.concat(), axis)
+    for (c, part) in parts.iter_mut().enumerate() {
+        run(c, part);
+    }
+    out.clear();
+    for p in parts.iter() {
+        out.extend_from_slice(p);
+    }
+    axis
 }
 
 impl BroadPhase for SortSweep {
@@ -153,10 +185,17 @@ impl BroadPhase for SortSweep {
     }
 
     fn update_pairs(&mut self) -> &PairChanges {
-        let live = self.store.live_indices();
-        let (keys, axis) = find_pairs(self.store.aabbs(), &live);
-        self.last_axis = axis;
-        self.cache.replace(&mut self.store, keys, false)
+        let bufs = &mut self.bufs;
+        self.store.live_indices_into(&mut bufs.live);
+        let mut pairs = std::mem::take(&mut bufs.pairs);
+        let live = std::mem::take(&mut bufs.live);
+        self.last_axis = find_pairs_into(self.store.aabbs(), &live, bufs, &mut pairs);
+        bufs.live = live;
+        let changes = self
+            .cache
+            .replace_reusing(&mut self.store, &mut pairs, false);
+        self.bufs.pairs = pairs;
+        changes
     }
 
     impl_common_broadphase!();
