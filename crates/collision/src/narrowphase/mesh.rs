@@ -508,13 +508,13 @@ fn contacts_in_box<M: ContactTriangles + ?Sized>(
 }
 
 /// Triangles A against convex hull B: [`mesh_convex_contacts`] with the triangle–hull
-/// separating-axis test of [`super::mesh_hull`], the hull placed in the mesh's frame once
+/// separating-axis test of `super::mesh_hull`, the hull placed in the mesh's frame once
 /// (vertices, face planes, in a per-thread `PlacedHull` refilled in place) for all the
 /// triangles instead of once per triangle. Given the same placed hull the contacts are those of the per-triangle
 /// `convex_convex` path bit for bit; the placement by a rotation matrix rounds differently
 /// from the quaternion's, by a few ulps.
 ///
-/// The hull's box comes from its SIMD vertex lanes ([`ConvexHull::rotated_bounds`], the
+/// The hull's box comes from its SIMD vertex lanes (`ConvexHull::rotated_bounds`, the
 /// same box as the placed vertices', bit for bit), and the hull is placed only when some
 /// triangle survives the midphase and the box's plane cull (`PlaneSlab::from_box`, which
 /// rejects only triangles the hull's own face test rejects): most hull–mesh pairs of a

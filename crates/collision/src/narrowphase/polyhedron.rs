@@ -207,7 +207,7 @@ pub const FACE_PREFERENCE: Real = 1.0e-3;
 /// Edge pairs whose directions make an angle with sine below this are skipped by the
 /// separating-axis test (parallel edges form no face of the Minkowski difference). Kept
 /// small: nearly parallel pairs still bound the depth (Gregorius' 0.005 overstated it by
-/// 1.4 mm at 2 cm in the polytope oracle); their witnesses are checked by [`edge_contact`].
+/// 1.4 mm at 2 cm in the polytope oracle); their witnesses are checked by `edge_contact`.
 pub const PARALLEL_SIN: Real = 1.0e-5;
 
 /// Relative tolerance (of the reference face's longest edge) within which a vertex counts as

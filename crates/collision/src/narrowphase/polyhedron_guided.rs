@@ -88,7 +88,7 @@ const FACE_COS: Real = 0.999;
 /// of parry's `contact_manifolds_pfm_pfm` and Bullet's `btPolyhedralContactClipping` after
 /// a GJK normal): one penetration query gives the normal `n`; when `n` is within about 2.6°
 /// of a face normal of A (or of B), that face is the reference face and the other shape's
-/// most anti-parallel face is clipped against it as in [`polyhedron_manifold`]; otherwise
+/// most anti-parallel face is clipped against it as in [`super::polyhedron::polyhedron_manifold`]; otherwise
 /// (edge–edge, vertex contacts) the single GJK/EPA point is the manifold. Cost: one GJK/EPA
 /// plus a scan of the faces, linear in the size of the shapes. `ca`/`cb` are the shapes
 /// behind the views `a`/`b`.
@@ -215,7 +215,7 @@ fn separation_along(
 }
 
 /// A box whose largest half extent exceeds this many times the hull's reach (radius about its
-/// origin) is cut down to the hull's neighbourhood by [`large_box_hull`].
+/// origin) is cut down to the hull's neighbourhood by `large_box_hull`.
 pub const LARGE_BOX_RATIO: Real = 4.0;
 
 /// Box–hull contact for a box much larger than the hull (a ground box), box `x` first, the

@@ -1,4 +1,4 @@
-//! The one check of a penetration answer (EPA's), shared by [`crate::query::contact`] and
+//! The one check of a penetration answer (EPA's), shared by [`crate::query::contact()`] and
 //! the narrowphase, and its bounded fallback.
 //!
 //! EPA on shapes that touch within round-off (or on a Minkowski difference much larger than
@@ -69,7 +69,7 @@ pub fn contact_is_consistent(
         && (n.dot(c.point_b) - hb).abs() <= tol
 }
 
-/// `c` re-measured exactly along its own normal ([`contact_along`]) when that exact
+/// `c` re-measured exactly along its own normal (`contact_along`) when that exact
 /// separation is within `slack` times the guard's tolerance of `c.distance` (a looser form of
 /// [`contact_is_consistent`] that drops the witnesses' check and replaces them); `None`
 /// otherwise. For polyhedra touching within round-off, where EPA's polytope is degenerate

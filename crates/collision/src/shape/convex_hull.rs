@@ -31,7 +31,7 @@ pub struct HullFace {
 /// It also stores each vertex's neighbours along the edges, for hill-climbing support queries
 /// (above [`ConvexHull::HILL_CLIMB_MIN_VERTICES`] vertices) and later for contact generation.
 ///
-/// Deserialising checks the stored data (see [`ConvexHullData`]), so corrupted or
+/// Deserialising checks the stored data (see `ConvexHullData`), so corrupted or
 /// inconsistent bytes give a [`CaromError`] instead of a panic in a support query.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(try_from = "ConvexHullData")]

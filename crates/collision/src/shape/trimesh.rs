@@ -35,7 +35,7 @@ impl Default for TriMeshOptions {
 /// adjacency built at construction. Degenerate (zero-area) triangles are kept; they never
 /// produce NaN in queries.
 ///
-/// Deserialising checks the stored data against its own triangles (see [`TriMeshData`]), so
+/// Deserialising checks the stored data against its own triangles (see `TriMeshData`), so
 /// corrupted or inconsistent bytes give a [`CaromError`] instead of a failure in a query.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(try_from = "TriMeshData")]

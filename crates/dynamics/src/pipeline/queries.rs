@@ -11,11 +11,11 @@
 //! [`WorldQuery`] keeps the tree for many queries against the same state (the batch form
 //! builds one for its whole batch).
 //!
-//! The world keeps the tree between queries ([`QueryCache`]): when the same bodies are
+//! The world keeps the tree between queries (`QueryCache`): when the same bodies are
 //! queried again, it is reused as is if no box changed, refitted to the new boxes otherwise
 //! (`Bvh::refit`, about a seventieth of a build's instructions for 1000 bodies), and
 //! rebuilt when the refitted tree's node area (`Bvh::node_area`, the surface area
-//! heuristic's cost for a fixed topology) has grown past [`QueryCache::REBUILD_GROWTH`]
+//! heuristic's cost for a fixed topology) has grown past `QueryCache::REBUILD_GROWTH`
 //! times the area it had when built, so the topology follows bodies that move far (Bullet's
 //! `btDbvt` refits and re-inserts for the same reason) while a settled scene keeps its tree.
 //! (It rebuilt after every eight refits before: in "raytests" the rebuilds were half the
