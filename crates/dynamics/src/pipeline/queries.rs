@@ -86,9 +86,9 @@ struct QueryObject<'w> {
 
 /// True only when the ray clearly misses the ball of `radius` around `center` within
 /// `[0, max_t]`: the ball's distance from the line, or its extent along the ray, is out of
-/// reach by more than a margin of 1e-4 of the lengths and coordinates involved, far above
-/// rounding (the centre comes from the world box), so a
-/// ray that meets the shape inside the ball is never turned away. NaN never rejects, and
+/// reach by more than a margin of 1e-4 of the lengths and coordinates involved. That is far
+/// above the rounding of the centre (taken from the world box) and of this test, so a ray
+/// that meets the shape inside the ball is never turned away. NaN never rejects, and
 /// neither does an infinite radius (planes).
 #[inline]
 fn misses_ball(ray: &Ray, center: Vec3, radius: Real, max_t: Real) -> bool {
