@@ -63,7 +63,7 @@ pub fn raycast(
     max_distance: Real,
     solid: bool,
 ) -> Result<Option<RayHit>> {
-    crate::query::check_pose("pose", pose)?;
+    let pose = crate::query::check_pose("pose", pose)?;
     let ray = Ray::new(origin, dir)?;
     if max_distance.is_nan() || max_distance < 0.0 {
         return Err(CaromError::invalid(
@@ -72,7 +72,7 @@ pub fn raycast(
             "must be >= 0",
         ));
     }
-    raycast_ray(shape, pose, &ray, max_distance, solid)
+    Ok(raycast_posed(shape, &pose, &ray, max_distance, solid))
 }
 
 /// [`raycast`] for a ray made once by [`Ray::new`] and cast against many shapes (a scene
@@ -88,11 +88,23 @@ pub fn raycast_ray(
     solid: bool,
 ) -> Result<Option<RayHit>> {
     let pose = crate::query::check_pose("pose", pose)?;
+    Ok(raycast_posed(shape, &pose, ray, max_distance, solid))
+}
+
+/// The cast of [`raycast`] and [`raycast_ray`] once their inputs are checked: the ray into
+/// the shape's frame, [`raycast_local`], the hit back to the world.
+fn raycast_posed(
+    shape: &Shape,
+    pose: &Isometry,
+    ray: &Ray,
+    max_distance: Real,
+    solid: bool,
+) -> Option<RayHit> {
     let local = Ray {
         origin: pose.inverse_transform_point(ray.origin),
         dir: pose.inverse_transform_vector(ray.dir),
     };
-    Ok(raycast_local(shape, &local, max_distance, solid).map(|h| h.transformed(&pose)))
+    raycast_local(shape, &local, max_distance, solid).map(|h| h.transformed(pose))
 }
 
 /// Reads a hit from an interval of parameters (`dir_len` converts parameters to
