@@ -1,7 +1,7 @@
 //! `carom-bench scenes`: Bullet's eight benchmark scenes (`carom-scenes`) run side by side by
 //! every in-process engine ([`engine::builders`]: Rapier via rapier3d 0.36.1) and by Bullet
 //! through pybullet ([`bullet_peer`]), sleeping off and on, on one thread and on all cores,
-//! several runs each; prints the table (ms/step, first-200 mean, settled median, stage split,
+//! several runs each (interleaved: run r of every configuration before run r + 1); prints the table (ms/step, first-200 mean, settled median, stage split,
 //! ratios, sanity) and the ray-batch table, and writes JSON, CSV and a PNG chart.
 //! `--check` runs a few steps per scene and checks the sanity figures instead of timing.
 
@@ -178,37 +178,48 @@ pub fn run(args: &Args) -> Result<(), String> {
             None
         };
         for &sleep in &sleeping {
-            for &t in &threads {
-                for &(name, build) in &engines {
+            // Round robin: run r of every configuration (thread count × engine, then
+            // Bullet) before run r + 1 of any, so a slow spell of a shared machine falls on
+            // all of them alike instead of on one configuration's block of runs; the ratios
+            // (Carom / peer, two threads / one) compare runs made minutes apart at most.
+            let configs: Vec<(usize, &str, engine::EngineBuilder)> = threads
+                .iter()
+                .flat_map(|&t| engines.iter().map(move |&(name, build)| (t, name, build)))
+                .collect();
+            let mut runs: Vec<Vec<RunRecord>> = vec![Vec::new(); configs.len()];
+            let mut records = Vec::new();
+            let mut mt = Vec::new();
+            for _ in 0..args.runs {
+                for (&(t, name, build), out) in configs.iter().zip(&mut runs) {
                     bar.set_message(format!("{} / {name} / {t} thr", scene.name));
                     let config = EngineConfig {
                         threads: t,
                         sleeping: sleep,
                     };
-                    let runs: Vec<RunRecord> = (0..args.runs)
-                        .map(|_| {
-                            record::run_in_process(scene, build, config, args.steps, &mut || {
-                                bar.inc(1)
-                            })
-                        })
-                        .collect::<Result<_, _>>()?;
-                    let s = stats::summarize(&runs);
-                    if let Some(ms) = s.rays_ms {
-                        rays.push(ray_row(&s, ms, scene));
-                    }
-                    summaries.push(s);
+                    out.push(record::run_in_process(
+                        scene,
+                        build,
+                        config,
+                        args.steps,
+                        &mut || bar.inc(1),
+                    )?);
                 }
-            }
-            if let Some(json) = &json {
-                bar.set_message(format!("{} / bullet", scene.name));
-                let mut records = Vec::new();
-                let mut mt = Vec::new();
-                for _ in 0..args.runs {
+                if let Some(json) = &json {
+                    bar.set_message(format!("{} / bullet", scene.name));
                     let r = bullet_peer::run(&python, scene, json, args.steps, sleep)?;
                     bar.inc(args.steps as u64);
                     mt.extend(r.ray_ms_mt);
                     records.push(r.record);
                 }
+            }
+            for runs in &runs {
+                let s = stats::summarize(runs);
+                if let Some(ms) = s.rays_ms {
+                    rays.push(ray_row(&s, ms, scene));
+                }
+                summaries.push(s);
+            }
+            if json.is_some() {
                 let s = stats::summarize(&records);
                 if let Some(ms) = s.rays_ms {
                     rays.push(ray_row(&s, ms, scene));
