@@ -1,10 +1,10 @@
 //! `carom-bench scenes`: Bullet's eight benchmark scenes (`carom-scenes`) run side by side by
 //! every in-process engine ([`engine::builders`]: Rapier via rapier3d 0.36.1) and by Bullet
 //! through pybullet ([`bullet_peer`]), sleeping off and on, on one thread and on all cores,
-//! several runs each (interleaved: run r of every configuration before run r + 1); prints the table (ms/step, first-200 mean, settled median, stage split,
-//! ratios, sanity) and the ray-batch table, and writes JSON, CSV and a PNG chart.
+//! several runs each (interleaved: run r of every configuration before run r + 1); prints
+//! the table (ms/step, first-200 mean, settled median, stage split, ratios, sanity) and the
+//! ray-batch table, and writes JSON, CSV and a PNG chart.
 //! `--check` runs a few steps per scene and checks the sanity figures instead of timing.
-
 pub mod bullet_peer;
 pub mod carom_engine;
 pub mod chart;
