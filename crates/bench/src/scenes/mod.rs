@@ -5,6 +5,7 @@
 //! the table (ms/step, first-200 mean, settled median, stage split, ratios, sanity) and the
 //! ray-batch table, and writes JSON, CSV and a PNG chart.
 //! `--check` runs a few steps per scene and checks the sanity figures instead of timing.
+
 pub mod bullet_peer;
 pub mod carom_engine;
 pub mod chart;
