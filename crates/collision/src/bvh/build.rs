@@ -132,8 +132,19 @@ struct Prim {
     id: u32,
 }
 
-/// Builds the hierarchy over `boxes` (at least one, all valid).
+/// Builds the hierarchy over `boxes` (at least one, all valid), with leaves of up to
+/// [`MAX_LEAF_SIZE`] primitives.
+#[cfg(test)]
 pub(crate) fn build(boxes: &[Aabb]) -> BuildOutput {
+    build_with_leaves(boxes, MAX_LEAF_SIZE)
+}
+
+/// [`build`] with leaves of up to `max_leaf` primitives (1 ..= [`MAX_LEAF_SIZE`]; clamped).
+/// Smaller leaves suit primitives whose own test costs far more than a node visit (a world
+/// query's bodies): the closest-first walk then orders every primitive by its box entry,
+/// not only the leaves.
+pub(crate) fn build_with_leaves(boxes: &[Aabb], max_leaf: usize) -> BuildOutput {
+    let max_leaf = max_leaf.clamp(1, MAX_LEAF_SIZE);
     let n = boxes.len();
     let mut order: Vec<Prim> = boxes
         .iter()
@@ -147,7 +158,7 @@ pub(crate) fn build(boxes: &[Aabb]) -> BuildOutput {
             }
         })
         .collect();
-    let mut nodes: Vec<BuildNode> = Vec::with_capacity(2 * n / MAX_LEAF_SIZE.max(2) + 8);
+    let mut nodes: Vec<BuildNode> = Vec::with_capacity(2 * n / max_leaf.max(2) + 8);
     let root = bounds_of(&order);
     let mut stack = vec![Task {
         start: 0,
@@ -162,7 +173,7 @@ pub(crate) fn build(boxes: &[Aabb]) -> BuildOutput {
             nodes[p].first_or_right = index as u32;
         }
         let prims = &mut order[task.start..task.end];
-        match choose_split(prims, &task.aabb, &task.centroids) {
+        match choose_split(prims, &task.aabb, &task.centroids, max_leaf) {
             Some((mid, left, right)) => {
                 nodes.push(BuildNode {
                     aabb: task.aabb.aabb(),
@@ -223,7 +234,12 @@ fn escape_indices(nodes: &[BuildNode]) -> Vec<u32> {
 /// Chooses a split of `prims` (reordering it) and returns the size of the left part and the
 /// bounds of both parts, or `None` to make a leaf. One pass bins the primitives on all three
 /// axes at once; the children's bounds come from the bins.
-fn choose_split(prims: &mut [Prim], bounds: &ABox, cb: &ABox) -> Option<(usize, Bin, Bin)> {
+fn choose_split(
+    prims: &mut [Prim],
+    bounds: &ABox,
+    cb: &ABox,
+    max_leaf: usize,
+) -> Option<(usize, Bin, Bin)> {
     let n = prims.len();
     if n <= 1 {
         return None;
@@ -275,7 +291,7 @@ fn choose_split(prims: &mut [Prim], bounds: &ABox, cb: &ABox) -> Option<(usize, 
         Some((cost, last, left, right)) => {
             let leaf_cost = n as Real * parent_area;
             let split_cost = TRAVERSAL_COST * parent_area + cost;
-            if n <= MAX_LEAF_SIZE && split_cost >= leaf_cost {
+            if n <= max_leaf && split_cost >= leaf_cost {
                 return None;
             }
             let mid = partition(prims, |p| bin_of(p.centroid[axis], min, k) <= last);
@@ -283,7 +299,7 @@ fn choose_split(prims: &mut [Prim], bounds: &ABox, cb: &ABox) -> Option<(usize, 
             Some((mid, left, right))
         }
         // All centroids coincide: split by position in the list.
-        None if n > MAX_LEAF_SIZE => {
+        None if n > max_leaf => {
             let mid = n / 2;
             let left = bounds_of(&prims[..mid]);
             let right = bounds_of(&prims[mid..]);
@@ -382,6 +398,29 @@ mod tests {
             .nodes
             .iter()
             .all(|n| !n.is_leaf() || n.count as usize <= MAX_LEAF_SIZE));
+    }
+
+    /// Leaves of one primitive: every leaf holds one, for spread, identical and nested boxes.
+    #[test]
+    fn single_primitive_leaves() {
+        let mut nested: Vec<Aabb> = (1..=9)
+            .map(|k| Aabb::new(Vec3::splat(-(k as Real)), Vec3::splat(k as Real)))
+            .collect();
+        nested.extend(random_boxes(40, 3));
+        for boxes in [
+            random_boxes(300, 11),
+            vec![Aabb::new(Vec3::ONE, Vec3::ONE); 37],
+            nested,
+        ] {
+            let out = build_with_leaves(&boxes, 1);
+            check_tree(&boxes, &out);
+            assert!(out.nodes.iter().all(|n| !n.is_leaf() || n.count == 1));
+            // Out-of-range sizes are clamped.
+            let zero = build_with_leaves(&boxes, 0);
+            assert_eq!(zero.order, out.order);
+            let big = build_with_leaves(&boxes, 1000);
+            assert_eq!(big.order, build(&boxes).order);
+        }
     }
 
     #[test]

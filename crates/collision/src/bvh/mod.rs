@@ -18,6 +18,8 @@ mod build;
 mod dynamic_tree;
 mod pair;
 mod quantize;
+#[cfg(test)]
+mod refit_tests;
 mod static_bvh;
 mod traverse;
 mod tree_insert;

@@ -11,9 +11,9 @@
 //!
 //! [`Bvh::refit`] recomputes the boxes after primitives moved without changing topology.
 
-use super::build::{build, BuildOutput};
+use super::build::{build_with_leaves, BuildOutput, MAX_LEAF_SIZE};
 use super::quantize::Quantization;
-use super::wide::{collapse, WideNode};
+use super::wide::{collapse, collapse_into, WideNode};
 use crate::error::{CaromError, Result};
 use crate::math::{Aabb, Real, Vec3, EPSILON};
 use serde::{Deserialize, Serialize};
@@ -77,7 +77,7 @@ pub struct Bvh {
     /// Primitive indices; a leaf covers a contiguous range.
     pub(crate) order: Vec<u32>,
     /// Exact bounds of all primitives.
-    bounds: Aabb,
+    pub(crate) bounds: Aabb,
     /// The quantised nodes collapsed to 4-wide nodes for closest-hit rays (`bvh::wide`);
     /// empty for the unquantised layout and when the root is a leaf.
     pub(crate) wide: Vec<WideNode>,
@@ -224,12 +224,26 @@ impl Bvh {
     /// is reported as `i` by the traversals. Errors for no boxes, invalid boxes, or more
     /// than [`MAX_PRIMITIVES`].
     pub fn new(boxes: &[Aabb], layout: BvhLayout) -> Result<Self> {
+        Self::with_max_leaf_size(boxes, layout, MAX_LEAF_SIZE)
+    }
+
+    /// [`Bvh::new`] with leaves of at most `max_leaf_size` primitives (clamped to
+    /// `1..=`[`MAX_LEAF_SIZE`]; `new` uses the largest). Leaves of one primitive suit
+    /// primitives that cost far more to test than a node visit, such as the bodies of a
+    /// world query: the closest-first ray walk then visits each one in the order its box is
+    /// entered and skips those beyond the closest hit, where a leaf's primitives would be
+    /// tested in storage order.
+    pub fn with_max_leaf_size(
+        boxes: &[Aabb],
+        layout: BvhLayout,
+        max_leaf_size: usize,
+    ) -> Result<Self> {
         check_boxes(boxes)?;
         let BuildOutput {
             nodes,
             escapes,
             order,
-        } = build(boxes);
+        } = build_with_leaves(boxes, max_leaf_size);
         let aabbs: Vec<Aabb> = nodes.iter().map(|n| n.aabb).collect();
         let data: Vec<u32> = nodes
             .iter()
@@ -322,21 +336,53 @@ impl Bvh {
                 ),
             ));
         }
-        let (_, data) = self.node_boxes_and_data();
-        let mut aabbs = vec![Aabb::EMPTY; data.len()];
-        for i in (0..data.len()).rev() {
-            aabbs[i] = if data[i] & LEAF_FLAG != 0 {
-                let (first, count) = leaf_range(data[i]);
-                self.order[first..first + count]
-                    .iter()
-                    .fold(Aabb::EMPTY, |acc, &p| acc.merge(&boxes[p as usize]))
-            } else {
-                aabbs[i + 1].merge(&aabbs[right_child(&data, i)])
-            };
+        // In place: the node boxes are fitted bottom-up from the node data (no node is
+        // dequantised), re-quantised into the same node array, and the 4-wide nodes are
+        // collapsed again into their own buffer. The same nodes as `make_nodes` and
+        // `wide_nodes` over fresh arrays (`refit_in_place_is_a_fresh_fit` compares them).
+        let order = &self.order;
+        let fit = |aabbs: &mut [Aabb], data: &dyn Fn(usize) -> u32| {
+            for i in (0..aabbs.len()).rev() {
+                let d = data(i);
+                aabbs[i] = if d & LEAF_FLAG != 0 {
+                    let (first, count) = leaf_range(d);
+                    order[first..first + count]
+                        .iter()
+                        .fold(Aabb::EMPTY, |acc, &p| acc.merge(&boxes[p as usize]))
+                } else {
+                    let left = data(i + 1);
+                    let right = if left & LEAF_FLAG != 0 {
+                        i + 2
+                    } else {
+                        left as usize
+                    };
+                    aabbs[i + 1].merge(&aabbs[right])
+                };
+            }
+        };
+        match &mut self.nodes {
+            Nodes::Quantized(v, q) => {
+                let mut aabbs = vec![Aabb::EMPTY; v.len()];
+                fit(&mut aabbs, &|i| v[i].data);
+                self.bounds = aabbs[0];
+                *q = Quantization::new(&self.bounds);
+                for (n, a) in v.iter_mut().zip(&aabbs) {
+                    n.min = q.quantize(a.min, false);
+                    n.max = q.quantize(a.max, true);
+                }
+                collapse_into(v, &mut self.wide);
+            }
+            Nodes::Unquantized(v) => {
+                let mut aabbs = vec![Aabb::EMPTY; v.len()];
+                fit(&mut aabbs, &|i| v[i].data);
+                self.bounds = aabbs[0];
+                for (n, a) in v.iter_mut().zip(&aabbs) {
+                    let p = pad_ulps(a);
+                    n.min = p.min.to_array();
+                    n.max = p.max.to_array();
+                }
+            }
         }
-        self.bounds = aabbs[0];
-        self.nodes = make_nodes(self.layout(), &aabbs, &data, &self.bounds);
-        self.wide = wide_nodes(&self.nodes);
         Ok(())
     }
 
@@ -454,7 +500,7 @@ impl Bvh {
     }
 
     /// Conservative boxes and data of all nodes.
-    fn node_boxes_and_data(&self) -> (Vec<Aabb>, Vec<u32>) {
+    pub(crate) fn node_boxes_and_data(&self) -> (Vec<Aabb>, Vec<u32>) {
         match &self.nodes {
             Nodes::Quantized(v, q) => (
                 v.iter().map(|n| q.dequantize(n.min, n.max)).collect(),
@@ -482,14 +528,14 @@ pub(crate) fn right_child(data: &[u32], i: usize) -> usize {
 }
 
 /// The 4-wide nodes of the quantised layout (none for the unquantised one).
-fn wide_nodes(nodes: &Nodes) -> Vec<WideNode> {
+pub(crate) fn wide_nodes(nodes: &Nodes) -> Vec<WideNode> {
     match nodes {
         Nodes::Quantized(v, _) => collapse(v),
         Nodes::Unquantized(_) => Vec::new(),
     }
 }
 
-fn make_nodes(layout: BvhLayout, aabbs: &[Aabb], data: &[u32], bounds: &Aabb) -> Nodes {
+pub(crate) fn make_nodes(layout: BvhLayout, aabbs: &[Aabb], data: &[u32], bounds: &Aabb) -> Nodes {
     match layout {
         BvhLayout::Quantized => {
             let q = Quantization::new(bounds);

@@ -19,7 +19,7 @@
 //! (Williams et al., "An Efficient and Robust Ray–Box Intersection Algorithm", JGT 2005),
 //! and scales the exit distance as Ize's robust test (`traverse::ROBUST_EXIT`).
 
-use super::static_bvh::{leaf_range, right_child, QuantizedNode, LEAF_FLAG};
+use super::static_bvh::{leaf_range, QuantizedNode, LEAF_FLAG};
 use super::traverse::{RayStack, ROBUST_EXIT};
 use crate::math::{Real, Vec3};
 
@@ -59,16 +59,33 @@ fn box_size(n: &QuantizedNode) -> u64 {
 /// Collapses the binary quantised nodes into 4-wide nodes (empty when the root is a leaf).
 /// Deterministic: ties in box size go to the first child in order.
 pub(crate) fn collapse(nodes: &[QuantizedNode]) -> Vec<WideNode> {
+    let mut wide = Vec::new();
+    collapse_into(nodes, &mut wide);
+    wide
+}
+
+/// [`collapse`] into `wide`, reusing its buffer (a refit collapses the same tree again).
+pub(crate) fn collapse_into(nodes: &[QuantizedNode], wide: &mut Vec<WideNode>) {
+    wide.clear();
     if nodes.is_empty() || nodes[0].data & LEAF_FLAG != 0 {
-        return Vec::new();
+        return;
     }
-    let data: Vec<u32> = nodes.iter().map(|n| n.data).collect();
-    let is_leaf = |i: usize| data[i] & LEAF_FLAG != 0;
-    let mut wide = vec![EMPTY_NODE];
-    // (binary node, wide node it becomes)
-    let mut stack = vec![(0usize, 0usize)];
+    let is_leaf = |i: usize| nodes[i].data & LEAF_FLAG != 0;
+    // The right child of internal node `i`: its left child's escape index.
+    let right_of = |i: usize| {
+        let left = nodes[i + 1].data;
+        if left & LEAF_FLAG != 0 {
+            i + 2
+        } else {
+            left as usize
+        }
+    };
+    wide.push(EMPTY_NODE);
+    // (binary node, wide node it becomes); the depth of a collapsed tree is far below 64.
+    let mut stack: Vec<(usize, usize)> = Vec::with_capacity(64);
+    stack.push((0, 0));
     while let Some((b, w)) = stack.pop() {
-        let mut kids = [b + 1, right_child(&data, b), 0, 0];
+        let mut kids = [b + 1, right_of(b), 0, 0];
         let mut n = 2;
         while n < 4 {
             let mut pick: Option<(usize, u64)> = None;
@@ -83,7 +100,7 @@ pub(crate) fn collapse(nodes: &[QuantizedNode]) -> Vec<WideNode> {
             let Some((j, _)) = pick else { break };
             let k = kids[j];
             kids[j] = k + 1;
-            kids[n] = right_child(&data, k);
+            kids[n] = right_of(k);
             n += 1;
         }
         let mut node = EMPTY_NODE;
@@ -93,7 +110,7 @@ pub(crate) fn collapse(nodes: &[QuantizedNode]) -> Vec<WideNode> {
                 node.planes[3 + a][lane] = nodes[k].max[a];
             }
             node.children[lane] = if is_leaf(k) {
-                data[k]
+                nodes[k].data
             } else {
                 wide.push(EMPTY_NODE);
                 stack.push((k, wide.len() - 1));
@@ -102,7 +119,6 @@ pub(crate) fn collapse(nodes: &[QuantizedNode]) -> Vec<WideNode> {
         }
         wide[w] = node;
     }
-    wide
 }
 
 /// A ray in quantised coordinates, prepared for the sign-ordered slab test.
