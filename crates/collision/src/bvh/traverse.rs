@@ -14,6 +14,7 @@ use super::quantize::Quantization;
 use super::static_bvh::{leaf_range, Bvh, Nodes, QuantizedNode, UnquantizedNode, LEAF_FLAG};
 use super::wide::{walk_ordered, WideRay};
 use crate::math::{Aabb, Real, Vec3, Vec3A, EPSILON};
+use smallvec::SmallVec;
 
 /// `1 + 2γ₃` with `γₙ = nε / (1 - nε)` (Ize 2013), plus slack for the quantised mapping and
 /// for the rounding of the leaf test's `t`, so a box is never culled against a tied hit.
@@ -408,41 +409,23 @@ pub(crate) fn right_child_of<N: NodeSet>(ns: &N, i: usize) -> usize {
     }
 }
 
-/// Deferred far children of the ordered ray walk: a fixed array, spilling to the heap only
-/// for trees deeper than it (degenerate inputs), so no allocation per ray.
-pub(crate) struct RayStack {
-    fixed: [(u32, Real); 48],
-    len: usize,
-    spill: Vec<(u32, Real)>,
-}
+/// Deferred far children of the ordered ray walk: an inline array, spilling to the heap only
+/// for trees deeper than it (degenerate inputs), so no allocation per ray. The inline array
+/// is left uninitialised (`SmallVec`): zeroing the 384 bytes of the array of 48 it replaced was a `memset` call per walk,
+/// 84 instructions of a world ray's ~5,500 for each of its two walks.
+pub(crate) struct RayStack(SmallVec<[(u32, Real); 64]>);
 
 impl RayStack {
     #[inline]
     pub(crate) fn new() -> Self {
-        RayStack {
-            fixed: [(0, 0.0); 48],
-            len: 0,
-            spill: Vec::new(),
-        }
+        RayStack(SmallVec::new())
     }
     #[inline]
     pub(crate) fn push(&mut self, e: (u32, Real)) {
-        if self.len < self.fixed.len() {
-            self.fixed[self.len] = e;
-            self.len += 1;
-        } else {
-            self.spill.push(e);
-        }
+        self.0.push(e);
     }
     #[inline]
     pub(crate) fn pop(&mut self) -> Option<(u32, Real)> {
-        if let Some(e) = self.spill.pop() {
-            return Some(e);
-        }
-        if self.len == 0 {
-            return None;
-        }
-        self.len -= 1;
-        Some(self.fixed[self.len])
+        self.0.pop()
     }
 }
