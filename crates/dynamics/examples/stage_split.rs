@@ -1,5 +1,6 @@
 //! Mean and median wall time of every pipeline stage of one `carom-scenes` scene (sleeping off,
-//! one thread unless told), to see where a step goes before profiling deeper.
+//! one thread unless told), to see where a step goes before profiling deeper. The last line,
+//! "(prepare)", is the part of "solver" that prepares the contacts and joints.
 //!
 //! `cargo run --release -p carom-dynamics --example stage_split -- [scene 1–8] [steps]
 //! [threads]`
@@ -27,6 +28,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         "integrate",
         "islands",
         "total",
+        "(prepare)",
     ];
     let mut t: Vec<Vec<f64>> = vec![vec![]; names.len()];
     let (mut pairs, mut manifolds, mut points) = (0, 0, 0);
@@ -42,6 +44,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             s.integrate,
             s.islands,
             s.total,
+            // Inside "solver": the contacts' and joints' preparation and the stage plan.
+            r.dynamics.timings.prepare,
         ];
         for (v, d) in t.iter_mut().zip(all) {
             v.push(d.as_secs_f64() * 1e3);
