@@ -61,6 +61,20 @@ pub fn draw(all: &[Summary], path: &Path) -> Result<(), String> {
                 String::new()
             }
         })
+        // Labels at 1, 2 and 5 times a power of ten only: the log scale's key points put
+        // two labels a hair apart at each decade ("10.0" printed twice, overlapping).
+        .y_label_formatter(&|y| {
+            let decade = 10f64.powf(y.log10().floor());
+            let m = y / decade;
+            let nice = [1.0, 2.0, 5.0, 10.0]
+                .iter()
+                .any(|k| (m - k).abs() < 1e-6 * k);
+            if nice && *y > 0.0 {
+                format!("{}", (y * 1e3).round() / 1e3)
+            } else {
+                String::new()
+            }
+        })
         .y_desc("ms per step (median of runs)")
         .label_style(("sans-serif", 15))
         .draw()
