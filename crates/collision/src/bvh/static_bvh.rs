@@ -13,6 +13,7 @@
 
 use super::build::{build_with_leaves, BuildOutput, MAX_LEAF_SIZE};
 use super::quantize::Quantization;
+use super::traverse::{right_child_of, with_nodes, NodeSet, QNodes};
 use super::wide::{collapse, collapse_into, WideNode};
 use crate::error::{CaromError, Result};
 use crate::math::{Aabb, Real, Vec3, EPSILON};
@@ -340,46 +341,19 @@ impl Bvh {
         // dequantised), re-quantised into the same node array, and the 4-wide nodes are
         // collapsed again into their own buffer. The same nodes as `make_nodes` and
         // `wide_nodes` over fresh arrays (`refit_in_place_is_a_fresh_fit` compares them).
-        let order = &self.order;
-        let fit = |aabbs: &mut [Aabb], data: &dyn Fn(usize) -> u32| {
-            for i in (0..aabbs.len()).rev() {
-                let d = data(i);
-                aabbs[i] = if d & LEAF_FLAG != 0 {
-                    let (first, count) = leaf_range(d);
-                    order[first..first + count]
-                        .iter()
-                        .fold(Aabb::EMPTY, |acc, &p| acc.merge(&boxes[p as usize]))
-                } else {
-                    let left = data(i + 1);
-                    let right = if left & LEAF_FLAG != 0 {
-                        i + 2
-                    } else {
-                        left as usize
-                    };
-                    aabbs[i + 1].merge(&aabbs[right])
-                };
-            }
-        };
+        let aabbs = with_nodes!(self, ns => fit_node_boxes(&ns, &self.order, boxes));
+        self.bounds = aabbs[0];
         match &mut self.nodes {
             Nodes::Quantized(v, q) => {
-                let mut aabbs = vec![Aabb::EMPTY; v.len()];
-                fit(&mut aabbs, &|i| v[i].data);
-                self.bounds = aabbs[0];
                 *q = Quantization::new(&self.bounds);
                 for (n, a) in v.iter_mut().zip(&aabbs) {
-                    n.min = q.quantize(a.min, false);
-                    n.max = q.quantize(a.max, true);
+                    *n = quantized_node(q, a, n.data);
                 }
                 collapse_into(v, &mut self.wide);
             }
             Nodes::Unquantized(v) => {
-                let mut aabbs = vec![Aabb::EMPTY; v.len()];
-                fit(&mut aabbs, &|i| v[i].data);
-                self.bounds = aabbs[0];
                 for (n, a) in v.iter_mut().zip(&aabbs) {
-                    let p = pad_ulps(a);
-                    n.min = p.min.to_array();
-                    n.max = p.max.to_array();
+                    *n = unquantized_node(a, n.data);
                 }
             }
         }
@@ -542,11 +516,7 @@ pub(crate) fn make_nodes(layout: BvhLayout, aabbs: &[Aabb], data: &[u32], bounds
             let nodes = aabbs
                 .iter()
                 .zip(data)
-                .map(|(a, &d)| QuantizedNode {
-                    min: q.quantize(a.min, false),
-                    max: q.quantize(a.max, true),
-                    data: d,
-                })
+                .map(|(a, &d)| quantized_node(&q, a, d))
                 .collect();
             Nodes::Quantized(nodes, q)
         }
@@ -554,17 +524,49 @@ pub(crate) fn make_nodes(layout: BvhLayout, aabbs: &[Aabb], data: &[u32], bounds
             aabbs
                 .iter()
                 .zip(data)
-                .map(|(a, &d)| {
-                    let p = pad_ulps(a);
-                    UnquantizedNode {
-                        min: p.min.to_array(),
-                        max: p.max.to_array(),
-                        data: d,
-                    }
-                })
+                .map(|(a, &d)| unquantized_node(a, d))
                 .collect(),
         ),
     }
+}
+
+/// The quantised node of box `a` (rounded outwards) with `data`.
+#[inline]
+fn quantized_node(q: &Quantization, a: &Aabb, data: u32) -> QuantizedNode {
+    QuantizedNode {
+        min: q.quantize(a.min, false),
+        max: q.quantize(a.max, true),
+        data,
+    }
+}
+
+/// The unquantised node of box `a` (padded by a few ulps) with `data`.
+#[inline]
+fn unquantized_node(a: &Aabb, data: u32) -> UnquantizedNode {
+    let p = pad_ulps(a);
+    UnquantizedNode {
+        min: p.min.to_array(),
+        max: p.max.to_array(),
+        data,
+    }
+}
+
+/// The exact box of every node of `ns` over the primitive `boxes` (leaves in `order`),
+/// fitted bottom-up: a node's children follow it in the depth-first layout.
+fn fit_node_boxes(ns: &impl NodeSet, order: &[u32], boxes: &[Aabb]) -> Vec<Aabb> {
+    let mut aabbs = vec![Aabb::EMPTY; ns.len()];
+    for i in (0..aabbs.len()).rev() {
+        let d = ns.data(i);
+        aabbs[i] = if d & LEAF_FLAG != 0 {
+            let (first, count) = leaf_range(d);
+            order[first..first + count]
+                .iter()
+                .fold(Aabb::EMPTY, |acc, &p| acc.merge(&boxes[p as usize]))
+        } else {
+            aabbs[i + 1].merge(&aabbs[right_child_of(ns, i)])
+        };
+    }
+    aabbs
 }
 
 #[cfg(test)]
