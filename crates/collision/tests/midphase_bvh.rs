@@ -5,7 +5,9 @@
 mod midphase_common;
 
 use carom_collision::math::{Aabb, Isometry, Quat, Real, Vec3};
-use carom_collision::midphase::{brute_force, triangle_aabbs, Bvh, BvhLayout, MeshView, WideNode};
+use carom_collision::midphase::{
+    brute_force, triangle_aabbs, Bvh, BvhLayout, MeshView, WideNode, WideRealNode,
+};
 use midphase_common::{grid_mesh, soup_mesh, Rng};
 
 struct Mesh {
@@ -267,10 +269,12 @@ fn quantized_nodes_are_small() {
     let per_tri = mesh.q.memory_bytes() as f64 / mesh.t.len() as f64;
     assert!(per_tri <= 32.0, "{per_tri} bytes per triangle");
     // The binary quantised nodes are smaller than the unquantised ones; the 4-wide nodes
-    // kept beside them for closest-hit rays are an extra 64 bytes each.
+    // kept beside them for closest-hit rays are an extra 64 bytes each (128 unquantised).
     let wide = mesh.q.num_wide_nodes() * std::mem::size_of::<WideNode>();
-    assert!(wide > 0 && mesh.u.num_wide_nodes() == 0);
-    assert!(mesh.q.memory_bytes() - wide < mesh.u.memory_bytes());
+    let wide_u = mesh.u.num_wide_nodes() * std::mem::size_of::<WideRealNode>();
+    assert!(wide > 0 && wide_u > 0);
+    assert_eq!(std::mem::size_of::<WideNode>(), 64);
+    assert!(mesh.q.memory_bytes() - wide < mesh.u.memory_bytes() - wide_u);
 }
 
 #[test]
@@ -309,7 +313,7 @@ fn rays_along_edges_and_faces_match_brute_force() {
 
 #[test]
 fn wide_walk_on_tiny_stacked_and_identical_meshes() {
-    // The quantised layout's closest-hit walk runs on 4-wide nodes: check it against brute
+    // The closest-hit walk runs on 4-wide nodes (both layouts): check it against brute
     // force where the collapse is unusual: one leaf (no wide node), a few triangles, a deep
     // stack of parallel triangles (many deferred children, ties only across layers) and
     // hundreds of identical triangles (every hit ties; the smallest index must win).

@@ -35,4 +35,4 @@ pub use quantize::Quantization;
 pub use static_bvh::{Bvh, BvhLayout, QuantizedNode, UnquantizedNode, MAX_PRIMITIVES};
 pub use tree_query::HalfSpace;
 pub use tree_wide::WideTree;
-pub use wide::WideNode;
+pub use wide::{WideNode, WideRealNode};

@@ -14,7 +14,7 @@
 use super::build::{build_with_leaves, BuildOutput, MAX_LEAF_SIZE};
 use super::quantize::Quantization;
 use super::traverse::{right_child_of, with_nodes, NodeSet, QNodes};
-use super::wide::{collapse, collapse_into, WideNode};
+use super::wide::{collapse, collapse_into, WideNodes};
 use crate::error::{CaromError, Result};
 use crate::math::{Aabb, Real, Vec3, EPSILON};
 use serde::{Deserialize, Serialize};
@@ -79,9 +79,9 @@ pub struct Bvh {
     pub(crate) order: Vec<u32>,
     /// Exact bounds of all primitives.
     pub(crate) bounds: Aabb,
-    /// The quantised nodes collapsed to 4-wide nodes for closest-hit rays (`bvh::wide`);
-    /// empty for the unquantised layout and when the root is a leaf.
-    pub(crate) wide: Vec<WideNode>,
+    /// The nodes collapsed to 4-wide nodes for closest-hit rays (`bvh::wide`), in the
+    /// layout's coordinates; empty when the root is a leaf.
+    pub(crate) wide: WideNodes,
 }
 
 /// The serialised form of a [`Bvh`]: everything but the derived 4-wide nodes. Loading checks
@@ -208,8 +208,10 @@ fn check_boxes(boxes: &[Aabb]) -> Result<()> {
             format!("a BVH holds at most {MAX_PRIMITIVES} primitives"),
         ));
     }
-    for (i, b) in boxes.iter().enumerate() {
-        if !b.is_valid() {
+    // One pass without branches (a refit checks every box each time), then the first bad
+    // box for the error.
+    if !boxes.iter().fold(true, |ok, b| ok & b.is_valid()) {
+        if let Some((i, b)) = boxes.iter().enumerate().find(|(_, b)| !b.is_valid()) {
             return Err(CaromError::invalid(
                 format!("boxes[{i}]"),
                 b,
@@ -288,8 +290,7 @@ impl Bvh {
         self.order.len()
     }
 
-    /// Number of 4-wide nodes the quantised layout keeps for closest-hit rays (0 for the
-    /// unquantised layout and for single-leaf hierarchies).
+    /// Number of 4-wide nodes kept for closest-hit rays (0 for single-leaf hierarchies).
     pub fn num_wide_nodes(&self) -> usize {
         self.wide.len()
     }
@@ -300,10 +301,7 @@ impl Bvh {
             Nodes::Quantized(v, _) => v.len() * std::mem::size_of::<QuantizedNode>(),
             Nodes::Unquantized(v) => v.len() * std::mem::size_of::<UnquantizedNode>(),
         };
-        nodes
-            + self.wide.len() * std::mem::size_of::<WideNode>()
-            + self.order.len() * 4
-            + std::mem::size_of::<Self>()
+        nodes + self.wide.bytes() + self.order.len() * 4 + std::mem::size_of::<Self>()
     }
 
     /// Exact bounds of all primitives.
@@ -349,11 +347,16 @@ impl Bvh {
                 for (n, a) in v.iter_mut().zip(&aabbs) {
                     *n = quantized_node(q, a, n.data);
                 }
-                collapse_into(v, &mut self.wide);
+                if let WideNodes::Quantized(w) = &mut self.wide {
+                    collapse_into(v.as_slice(), w);
+                }
             }
             Nodes::Unquantized(v) => {
                 for (n, a) in v.iter_mut().zip(&aabbs) {
                     *n = unquantized_node(a, n.data);
+                }
+                if let WideNodes::Unquantized(w) = &mut self.wide {
+                    collapse_into(v.as_slice(), w);
                 }
             }
         }
@@ -493,11 +496,11 @@ pub(crate) fn right_child(data: &[u32], i: usize) -> usize {
     }
 }
 
-/// The 4-wide nodes of the quantised layout (none for the unquantised one).
-pub(crate) fn wide_nodes(nodes: &Nodes) -> Vec<WideNode> {
+/// The 4-wide nodes of either layout.
+pub(crate) fn wide_nodes(nodes: &Nodes) -> WideNodes {
     match nodes {
-        Nodes::Quantized(v, _) => collapse(v),
-        Nodes::Unquantized(_) => Vec::new(),
+        Nodes::Quantized(v, _) => WideNodes::Quantized(collapse(v.as_slice())),
+        Nodes::Unquantized(v) => WideNodes::Unquantized(collapse(v.as_slice())),
     }
 }
 

@@ -12,7 +12,7 @@
 
 use super::quantize::Quantization;
 use super::static_bvh::{leaf_range, Bvh, Nodes, QuantizedNode, UnquantizedNode, LEAF_FLAG};
-use super::wide::{walk_ordered, WideRay};
+use super::wide::{walk_ordered, WideNodes, WideRay};
 use crate::math::{Aabb, Real, Vec3, Vec3A, EPSILON};
 use smallvec::SmallVec;
 
@@ -289,8 +289,8 @@ impl Bvh {
     /// Like [`Bvh::for_each_candidate_on_ray`], but visits the nearer child first and skips
     /// subtrees entered beyond the current `max_t`: the fast path for closest hits. Uses a
     /// small stack of deferred far children (the stackless walk cannot order children).
-    /// The quantised layout walks its 4-wide nodes (`bvh::wide`), the unquantised one its
-    /// binary nodes; both visit every primitive a closest hit needs.
+    /// Both layouts walk their 4-wide nodes (`bvh::wide`), and a tree whose root is a leaf
+    /// its one leaf; every primitive a closest hit needs is visited.
     pub fn for_each_candidate_on_ray_ordered(
         &self,
         origin: Vec3,
@@ -299,16 +299,21 @@ impl Bvh {
         mut f: impl FnMut(u32, &mut Real) -> bool,
     ) {
         let mut max_t = max_t;
-        if let (Nodes::Quantized(_, q), false) = (&self.nodes, self.wide.is_empty()) {
-            let (o, d, pad) = quantized_ray(q, origin, dir);
-            walk_ordered(
-                &self.wide,
-                &self.order,
-                &WideRay::new(o, d, pad),
-                &mut max_t,
-                f,
-            );
-            return;
+        match (&self.nodes, &self.wide) {
+            (Nodes::Quantized(_, q), WideNodes::Quantized(w)) if !w.is_empty() => {
+                let (o, d, pad) = quantized_ray(q, origin, dir);
+                let ray = WideRay::new(o, d, pad);
+                walk_ordered(w, &self.order, &ray, &mut max_t, f);
+                return;
+            }
+            (Nodes::Unquantized(_), WideNodes::Unquantized(w)) if !w.is_empty() => {
+                // The boxes are padded by a few ulps already (`pad_ulps`), as for the
+                // binary walk.
+                let ray = WideRay::new(origin, dir, Vec3::ZERO);
+                walk_ordered(w, &self.order, &ray, &mut max_t, f);
+                return;
+            }
+            _ => {}
         }
         with_nodes!(self, ns => {
             let r = ns.ray(origin, dir);

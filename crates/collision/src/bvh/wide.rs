@@ -19,7 +19,7 @@
 //! (Williams et al., "An Efficient and Robust Ray–Box Intersection Algorithm", JGT 2005),
 //! and scales the exit distance as Ize's robust test (`traverse::ROBUST_EXIT`).
 
-use super::static_bvh::{leaf_range, QuantizedNode, LEAF_FLAG};
+use super::static_bvh::{leaf_range, QuantizedNode, UnquantizedNode, LEAF_FLAG};
 use super::traverse::{RayStack, ROBUST_EXIT};
 use crate::math::{Real, Vec3};
 
@@ -50,37 +50,163 @@ const EMPTY_NODE: WideNode = WideNode {
     children: [EMPTY; 4],
 };
 
-/// Area-like size of a quantised box (ordering only).
-fn box_size(n: &QuantizedNode) -> u64 {
-    let e = [0, 1, 2].map(|a| u64::from(n.max[a].saturating_sub(n.min[a])) + 1);
-    e[0] * e[1] + e[1] * e[2] + e[2] * e[0]
+/// Four child boxes in [`Real`] coordinates and their references: the 4-wide node of the
+/// unquantised layout (112 bytes in `f32`, two cache lines). The boxes are the binary
+/// nodes' boxes (padded outward by a few ulps), plane by plane as in [`WideNode`], so the
+/// slab test loads each plane as it is: no conversion, and a refit writes them without
+/// quantising. Small trees that are refitted often (the world query's tree over the
+/// bodies) use this layout.
+#[repr(C, align(64))]
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct WideRealNode {
+    /// Child boxes plane by plane: min x, min y, min z, max x, max y, max z; lane `k` is
+    /// child `k`. Unused lanes hold an inverted box.
+    pub planes: [[Real; 4]; 6],
+    /// Child references, as in [`WideNode::children`].
+    pub children: [u32; 4],
 }
 
-/// Collapses the binary quantised nodes into 4-wide nodes (empty when the root is a leaf).
+const EMPTY_REAL_NODE: WideRealNode = WideRealNode {
+    planes: [
+        [Real::MAX; 4],
+        [Real::MAX; 4],
+        [Real::MAX; 4],
+        [-Real::MAX; 4],
+        [-Real::MAX; 4],
+        [-Real::MAX; 4],
+    ],
+    children: [EMPTY; 4],
+};
+
+/// The 4-wide nodes of a hierarchy, in its layout's coordinates.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) enum WideNodes {
+    Quantized(Vec<WideNode>),
+    Unquantized(Vec<WideRealNode>),
+}
+
+impl WideNodes {
+    /// Number of wide nodes (0 when the root is a leaf).
+    pub(crate) fn len(&self) -> usize {
+        match self {
+            WideNodes::Quantized(v) => v.len(),
+            WideNodes::Unquantized(v) => v.len(),
+        }
+    }
+
+    /// Bytes of the wide nodes.
+    pub(crate) fn bytes(&self) -> usize {
+        match self {
+            WideNodes::Quantized(v) => std::mem::size_of_val(v.as_slice()),
+            WideNodes::Unquantized(v) => std::mem::size_of_val(v.as_slice()),
+        }
+    }
+}
+
+/// Binary nodes that collapse into 4-wide ones.
+pub(crate) trait WideSource {
+    /// The wide node they collapse into.
+    type Wide: Copy;
+    /// A wide node with no children.
+    const EMPTY: Self::Wide;
+    /// Area-like size of a node's box (ordering only).
+    type Size: PartialOrd + Copy;
+    fn len(&self) -> usize;
+    fn data(&self, i: usize) -> u32;
+    fn size(&self, i: usize) -> Self::Size;
+    /// Writes node `i`'s box into lane `lane` of `w`.
+    fn set_lane(&self, w: &mut Self::Wide, lane: usize, i: usize);
+    /// The children of a wide node.
+    fn children(w: &mut Self::Wide) -> &mut [u32; 4];
+}
+
+impl WideSource for [QuantizedNode] {
+    type Wide = WideNode;
+    const EMPTY: WideNode = EMPTY_NODE;
+    type Size = u64;
+    #[inline(always)]
+    fn len(&self) -> usize {
+        <[QuantizedNode]>::len(self)
+    }
+    #[inline(always)]
+    fn data(&self, i: usize) -> u32 {
+        self[i].data
+    }
+    #[inline(always)]
+    fn size(&self, i: usize) -> u64 {
+        let n = &self[i];
+        let e = [0, 1, 2].map(|a| u64::from(n.max[a].saturating_sub(n.min[a])) + 1);
+        e[0] * e[1] + e[1] * e[2] + e[2] * e[0]
+    }
+    #[inline(always)]
+    fn set_lane(&self, w: &mut WideNode, lane: usize, i: usize) {
+        for a in 0..3 {
+            w.planes[a][lane] = self[i].min[a];
+            w.planes[3 + a][lane] = self[i].max[a];
+        }
+    }
+    #[inline(always)]
+    fn children(w: &mut WideNode) -> &mut [u32; 4] {
+        &mut w.children
+    }
+}
+
+impl WideSource for [UnquantizedNode] {
+    type Wide = WideRealNode;
+    const EMPTY: WideRealNode = EMPTY_REAL_NODE;
+    type Size = Real;
+    #[inline(always)]
+    fn len(&self) -> usize {
+        <[UnquantizedNode]>::len(self)
+    }
+    #[inline(always)]
+    fn data(&self, i: usize) -> u32 {
+        self[i].data
+    }
+    #[inline(always)]
+    fn size(&self, i: usize) -> Real {
+        let n = &self[i];
+        let e = [0, 1, 2].map(|a| n.max[a] - n.min[a]);
+        e[0] * e[1] + e[1] * e[2] + e[2] * e[0]
+    }
+    #[inline(always)]
+    fn set_lane(&self, w: &mut WideRealNode, lane: usize, i: usize) {
+        for a in 0..3 {
+            w.planes[a][lane] = self[i].min[a];
+            w.planes[3 + a][lane] = self[i].max[a];
+        }
+    }
+    #[inline(always)]
+    fn children(w: &mut WideRealNode) -> &mut [u32; 4] {
+        &mut w.children
+    }
+}
+
+/// Collapses binary nodes into 4-wide nodes (empty when the root is a leaf).
 /// Deterministic: ties in box size go to the first child in order.
-pub(crate) fn collapse(nodes: &[QuantizedNode]) -> Vec<WideNode> {
+pub(crate) fn collapse<S: WideSource + ?Sized>(nodes: &S) -> Vec<S::Wide> {
     let mut wide = Vec::new();
     collapse_into(nodes, &mut wide);
     wide
 }
 
 /// [`collapse`] into `wide`, reusing its buffer (a refit collapses the same tree again).
-pub(crate) fn collapse_into(nodes: &[QuantizedNode], wide: &mut Vec<WideNode>) {
+pub(crate) fn collapse_into<S: WideSource + ?Sized>(nodes: &S, wide: &mut Vec<S::Wide>) {
     wide.clear();
-    if nodes.is_empty() || nodes[0].data & LEAF_FLAG != 0 {
+    if nodes.len() == 0 || nodes.data(0) & LEAF_FLAG != 0 {
         return;
     }
-    let is_leaf = |i: usize| nodes[i].data & LEAF_FLAG != 0;
+    let is_leaf = |i: usize| nodes.data(i) & LEAF_FLAG != 0;
     // The right child of internal node `i`: its left child's escape index.
     let right_of = |i: usize| {
-        let left = nodes[i + 1].data;
+        let left = nodes.data(i + 1);
         if left & LEAF_FLAG != 0 {
             i + 2
         } else {
             left as usize
         }
     };
-    wide.push(EMPTY_NODE);
+    wide.push(S::EMPTY);
     // (binary node, wide node it becomes); the depth of a collapsed tree is far below 64.
     let mut stack: Vec<(usize, usize)> = Vec::with_capacity(64);
     stack.push((0, 0));
@@ -88,10 +214,10 @@ pub(crate) fn collapse_into(nodes: &[QuantizedNode], wide: &mut Vec<WideNode>) {
         let mut kids = [b + 1, right_of(b), 0, 0];
         let mut n = 2;
         while n < 4 {
-            let mut pick: Option<(usize, u64)> = None;
+            let mut pick: Option<(usize, S::Size)> = None;
             for (j, &k) in kids[..n].iter().enumerate() {
                 if !is_leaf(k) {
-                    let s = box_size(&nodes[k]);
+                    let s = nodes.size(k);
                     if pick.is_none_or(|(_, best)| s > best) {
                         pick = Some((j, s));
                     }
@@ -103,16 +229,13 @@ pub(crate) fn collapse_into(nodes: &[QuantizedNode], wide: &mut Vec<WideNode>) {
             kids[n] = right_of(k);
             n += 1;
         }
-        let mut node = EMPTY_NODE;
+        let mut node = S::EMPTY;
         for (lane, &k) in kids[..n].iter().enumerate() {
-            for a in 0..3 {
-                node.planes[a][lane] = nodes[k].min[a];
-                node.planes[3 + a][lane] = nodes[k].max[a];
-            }
-            node.children[lane] = if is_leaf(k) {
-                nodes[k].data
+            nodes.set_lane(&mut node, lane, k);
+            S::children(&mut node)[lane] = if is_leaf(k) {
+                nodes.data(k)
             } else {
-                wide.push(EMPTY_NODE);
+                wide.push(S::EMPTY);
                 stack.push((k, wide.len() - 1));
                 (wide.len() - 1) as u32
             };
@@ -121,7 +244,38 @@ pub(crate) fn collapse_into(nodes: &[QuantizedNode], wide: &mut Vec<WideNode>) {
     }
 }
 
-/// A ray in quantised coordinates, prepared for the sign-ordered slab test.
+/// A wide node as the slab test reads it: its children and its planes as [`Real`] lanes.
+pub(crate) trait WideBoxes {
+    fn children(&self) -> &[u32; 4];
+    /// Plane row `r` (see [`WideNode::planes`]).
+    fn row(&self, r: usize) -> [Real; 4];
+}
+
+impl WideBoxes for WideNode {
+    #[inline(always)]
+    fn children(&self) -> &[u32; 4] {
+        &self.children
+    }
+    /// The `u16` lanes converted (exactly).
+    #[inline(always)]
+    fn row(&self, r: usize) -> [Real; 4] {
+        self.planes[r].map(Real::from)
+    }
+}
+
+impl WideBoxes for WideRealNode {
+    #[inline(always)]
+    fn children(&self) -> &[u32; 4] {
+        &self.children
+    }
+    #[inline(always)]
+    fn row(&self, r: usize) -> [Real; 4] {
+        self.planes[r]
+    }
+}
+
+/// A ray in a wide node layout's coordinates (quantised, or world coordinates for
+/// [`WideRealNode`]s), prepared for the sign-ordered slab test.
 pub(crate) struct WideRay {
     /// Plane row of the near and far plane per axis.
     near_row: [usize; 3],
@@ -166,7 +320,7 @@ impl WideRay {
     /// run as one SSE2 vector ([`WideRay::entries_sse2`]), with the bits of
     /// [`WideRay::entries_scalar`].
     #[inline(always)]
-    fn entries(&self, node: &WideNode, max_t: Real) -> [Real; 4] {
+    fn entries<N: WideBoxes>(&self, node: &N, max_t: Real) -> [Real; 4] {
         #[cfg(all(target_arch = "x86_64", not(feature = "f64")))]
         {
             self.entries_sse2(node, max_t)
@@ -183,15 +337,15 @@ impl WideRay {
         all(target_arch = "x86_64", not(feature = "f64"), not(test)),
         allow(dead_code)
     )]
-    fn entries_scalar(&self, node: &WideNode, max_t: Real) -> [Real; 4] {
+    fn entries_scalar<N: WideBoxes>(&self, node: &N, max_t: Real) -> [Real; 4] {
         let mut near = [0.0 as Real; 4];
         let mut far = [max_t; 4];
         for a in 0..3 {
-            let np = &node.planes[self.near_row[a]];
-            let fp = &node.planes[self.far_row[a]];
+            let np = node.row(self.near_row[a]);
+            let fp = node.row(self.far_row[a]);
             for k in 0..4 {
-                let tn = (Real::from(np[k]) + self.near_off[a]) * self.inv[a];
-                let tf = (Real::from(fp[k]) + self.far_off[a]) * self.inv[a];
+                let tn = (np[k] + self.near_off[a]) * self.inv[a];
+                let tf = (fp[k] + self.far_off[a]) * self.inv[a];
                 near[k] = if tn > near[k] { tn } else { near[k] };
                 far[k] = if tf < far[k] { tf } else { far[k] };
             }
@@ -215,12 +369,9 @@ impl WideRay {
     /// the scalar form.
     #[cfg(all(target_arch = "x86_64", not(feature = "f64")))]
     #[inline(always)]
-    fn entries_sse2(&self, node: &WideNode, max_t: Real) -> [Real; 4] {
+    fn entries_sse2<N: WideBoxes>(&self, node: &N, max_t: Real) -> [Real; 4] {
         use glam::Vec4;
-        let row = |r: usize| {
-            let p = node.planes[r];
-            Vec4::new(p[0].into(), p[1].into(), p[2].into(), p[3].into())
-        };
+        let row = |r: usize| Vec4::from_array(node.row(r));
         let mut near = Vec4::ZERO;
         let mut far = Vec4::splat(max_t);
         for a in 0..3 {
@@ -239,8 +390,8 @@ impl WideRay {
 /// ones deferred on a small stack and dropped when they are entered beyond the current
 /// `max_t`. `f(primitive, &mut max_t)` may shrink `max_t`, and returns `false` to stop.
 #[inline(always)]
-pub(crate) fn walk_ordered(
-    wide: &[WideNode],
+pub(crate) fn walk_ordered<N: WideBoxes>(
+    wide: &[N],
     order: &[u32],
     ray: &WideRay,
     max_t: &mut Real,
@@ -258,7 +409,7 @@ pub(crate) fn walk_ordered(
         // The children entered, sorted by entry (ties keep lane order).
         let mut hit = [(0.0 as Real, 0u32); 4];
         let mut m = 0;
-        for (&t, &child) in entry.iter().zip(&n.children) {
+        for (&t, &child) in entry.iter().zip(n.children()) {
             if t < Real::INFINITY && child != EMPTY {
                 let mut j = m;
                 while j > 0 && hit[j - 1].0 > t {
@@ -351,11 +502,28 @@ mod tests {
                 got.map(Real::to_bits),
                 "case {case}: o {o}, d {d}, max_t {max_t}"
             );
+            // The same boxes as `Real` planes (with their unused lanes inverted as
+            // `EMPTY_REAL_NODE` has them): the same entries, in both forms.
+            let mut real = EMPTY_REAL_NODE;
+            for (row, q) in real.planes.iter_mut().zip(&node.planes) {
+                for (x, &v) in row.iter_mut().zip(q).take(lanes) {
+                    *x = Real::from(v);
+                }
+            }
+            let ray = WideRay::new(o, d, Vec3::ZERO);
+            let want = ray.entries_scalar(&node, max_t);
+            for got in [ray.entries_scalar(&real, max_t), ray.entries(&real, max_t)] {
+                for k in 0..lanes {
+                    assert_eq!(want[k].to_bits(), got[k].to_bits(), "case {case} lane {k}");
+                }
+                assert!(got[lanes..].iter().all(|&t| t == Real::INFINITY));
+            }
         }
     }
 
     #[test]
     fn collapse_keeps_every_leaf_once() {
+        use crate::bvh::static_bvh::Nodes;
         for n in [1usize, 2, 3, 9, 40, 500] {
             let boxes: Vec<Aabb> = (0..n)
                 .map(|i| {
@@ -366,36 +534,56 @@ mod tests {
                 })
                 .collect();
             let bvh = Bvh::new(&boxes, BvhLayout::Quantized).unwrap();
-            let crate::bvh::static_bvh::Nodes::Quantized(nodes, _) = &bvh.nodes else {
+            let real = bvh.with_layout(BvhLayout::Unquantized);
+            let (Nodes::Quantized(nodes, _), Nodes::Unquantized(real_nodes)) =
+                (&bvh.nodes, &real.nodes)
+            else {
                 unreachable!()
             };
-            let wide = collapse(nodes);
-            let mut leaves: Vec<u32> = nodes
+            let leaves: Vec<u32> = nodes
                 .iter()
                 .map(|n| n.data)
                 .filter(|d| d & LEAF_FLAG != 0)
                 .collect();
-            if leaves.len() == 1 {
-                assert!(wide.is_empty());
-                continue;
-            }
-            let mut got: Vec<u32> = wide
+            // Both layouts collapse the same binary topology (their size orders may pick
+            // different grandchildren to pull up).
+            let children: Vec<[u32; 4]> = collapse(nodes.as_slice())
                 .iter()
-                .flat_map(|w| w.children)
-                .filter(|&c| c != EMPTY && c & LEAF_FLAG != 0)
+                .map(|w| w.children)
                 .collect();
-            leaves.sort_unstable();
-            got.sort_unstable();
-            assert_eq!(got, leaves);
-            // Every wide node but the root is referenced exactly once.
-            let mut refs: Vec<u32> = wide
+            let real_children: Vec<[u32; 4]> = collapse(real_nodes.as_slice())
                 .iter()
-                .flat_map(|w| w.children)
-                .filter(|&c| c != EMPTY && c & LEAF_FLAG == 0)
+                .map(|w| w.children)
                 .collect();
-            refs.sort_unstable();
-            assert_eq!(refs, (1..wide.len() as u32).collect::<Vec<_>>());
-            assert!(wide.iter().all(|w| w.children[1] != EMPTY));
+            check_collapse(&children, leaves.clone());
+            check_collapse(&real_children, leaves);
         }
+    }
+
+    /// Every leaf in exactly one lane, every wide node but the root referenced once, and
+    /// at least two children per node.
+    fn check_collapse(wide: &[[u32; 4]], mut leaves: Vec<u32>) {
+        if leaves.len() == 1 {
+            assert!(wide.is_empty());
+            return;
+        }
+        let mut got: Vec<u32> = wide
+            .iter()
+            .flatten()
+            .copied()
+            .filter(|&c| c != EMPTY && c & LEAF_FLAG != 0)
+            .collect();
+        leaves.sort_unstable();
+        got.sort_unstable();
+        assert_eq!(got, leaves);
+        let mut refs: Vec<u32> = wide
+            .iter()
+            .flatten()
+            .copied()
+            .filter(|&c| c != EMPTY && c & LEAF_FLAG == 0)
+            .collect();
+        refs.sort_unstable();
+        assert_eq!(refs, (1..wide.len() as u32).collect::<Vec<_>>());
+        assert!(wide.iter().all(|w| w[1] != EMPTY));
     }
 }

@@ -46,7 +46,8 @@ impl Aabb {
     /// True when the bounds are finite and `min <= max` on every axis.
     #[inline]
     pub fn is_valid(&self) -> bool {
-        self.min.is_finite() && self.max.is_finite() && self.min.cmple(self.max).all()
+        // Masks combined without short circuits: no branch per component.
+        (self.min.is_finite_mask() & self.max.is_finite_mask() & self.min.cmple(self.max)).all()
     }
 
     /// True for [`Aabb::EMPTY`]-like boxes (some `min > max`).

@@ -19,8 +19,8 @@ mod triangle_source;
 mod trimesh_query;
 
 pub use crate::bvh::{
-    Bvh, BvhLayout, Quantization, QuantizedNode, UnquantizedNode, WideNode, MAX_LEAF_SIZE,
-    MAX_PRIMITIVES, NUM_BINS,
+    Bvh, BvhLayout, Quantization, QuantizedNode, UnquantizedNode, WideNode, WideRealNode,
+    MAX_LEAF_SIZE, MAX_PRIMITIVES, NUM_BINS,
 };
 pub use crate::shape::triangle_aabbs;
 pub use compound_query::{
