@@ -34,7 +34,7 @@
 use super::World;
 use crate::body_set::BodyHandle;
 use carom_collision::broadphase::Filter;
-use carom_collision::math::{check_finite_vec, check_isometry, Aabb, Isometry, Real, Vec3};
+use carom_collision::math::{check_finite_vec, check_isometry, Aabb, Isometry, Mat3, Real, Vec3};
 use carom_collision::midphase::{Bvh, BvhLayout};
 use carom_collision::query::{raycast_ray, shape_cast, Ray, RayHit, ShapeCastHit};
 use carom_collision::shape::Shape;
@@ -66,9 +66,9 @@ pub struct BodyShapeCastHit {
 pub struct WorldQuery<'w> {
     objects: Vec<QueryObject<'w>>,
     bvh: Option<Bvh>,
-    /// Where the tree goes back when the query is dropped, with the boxes it was fitted to
-    /// and its node area when built.
-    cache: Option<(&'w QueryCache, Vec<Aabb>, Real)>,
+    /// Where the tree goes back when the query is dropped, with the bodies and boxes it was
+    /// fitted to and its node area when built.
+    cache: Option<(&'w QueryCache, Vec<BodyHandle>, Vec<Aabb>, Real)>,
 }
 
 /// A body as a query sees it: its shape at its current pose, and a ball around the shape
@@ -189,8 +189,9 @@ impl std::fmt::Debug for QueryCache {
 
 impl Drop for WorldQuery<'_> {
     fn drop(&mut self) {
-        if let (Some(bvh), Some((cache, boxes, area))) = (self.bvh.take(), self.cache.take()) {
-            let bodies = self.objects.iter().map(|o| o.body).collect();
+        if let (Some(bvh), Some((cache, bodies, boxes, area))) =
+            (self.bvh.take(), self.cache.take())
+        {
             cache.put(bvh, bodies, boxes, area);
         }
     }
@@ -365,13 +366,18 @@ impl World {
             let pose = set.pose_of(body.index as usize);
             // Arvo's transformed local box: conservative and O(1) (the tight box costs six
             // support queries per hull, which made the 500-ray batch of the raytests scene
-            // 1.4x slower); planes are unbounded, so they keep their own box.
+            // 1.4x slower), with the box's centre through the same matrix as its half
+            // extents (`Aabb::transformed` rotates it by the quaternion as well); planes are
+            // unbounded, so they keep their own box.
             let (world, center, radius) = match &*o.shape {
                 Shape::Plane(_) => (o.shape.aabb(&pose), pose.translation, Real::INFINITY),
                 s => {
                     let local = s.local_aabb();
-                    let world = local.transformed(&pose);
-                    (world, world.center(), local.half_extents().length())
+                    let r = Mat3::from_quat(pose.rotation);
+                    let half = local.half_extents();
+                    let c = r * local.center() + pose.translation;
+                    let world = Aabb::from_center_half_extents(c, r.abs() * half);
+                    (world, c, half.length())
                 }
             };
             boxes.push(world);
@@ -396,7 +402,7 @@ impl World {
         Ok(WorldQuery {
             objects,
             bvh: Some(bvh),
-            cache: Some((&self.query_cache, boxes, area)),
+            cache: Some((&self.query_cache, bodies, boxes, area)),
         })
     }
 
