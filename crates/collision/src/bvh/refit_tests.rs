@@ -1,7 +1,9 @@
 //! `Bvh::refit` in place against the refit it replaced (every node box fitted into a new
-//! array from decoded node data, then fresh quantised and 4-wide arrays), bit for bit.
+//! array from decoded node data, then fresh quantised and 4-wide arrays), bit for bit; the
+//! unquantised layout's wide nodes keep their lanes, with their boxes read again.
 
-use super::static_bvh::{leaf_range, make_nodes, right_child, wide_nodes, LEAF_FLAG};
+use super::static_bvh::{leaf_range, make_nodes, right_child, wide_nodes, Nodes, LEAF_FLAG};
+use super::wide::WideNodes;
 use super::{Bvh, BvhLayout};
 use crate::math::{Aabb, Real, Vec3};
 
@@ -22,7 +24,24 @@ fn fresh_fit(bvh: &Bvh, boxes: &[Aabb]) -> Bvh {
     let mut out = bvh.clone();
     out.bounds = aabbs[0];
     out.nodes = make_nodes(bvh.layout(), &aabbs, &data, &out.bounds);
-    out.wide = wide_nodes(&out.nodes);
+    match (&out.nodes, &mut out.wide) {
+        // The unquantised wide nodes keep their lanes: each lane's box is the new box of the
+        // binary node it names.
+        (Nodes::Unquantized(v), WideNodes::Unquantized(w)) => {
+            for node in w.iter_mut() {
+                for lane in 0..4 {
+                    let src = node.sources[lane];
+                    if src != u32::MAX {
+                        for a in 0..3 {
+                            node.planes[a][lane] = v[src as usize].min[a];
+                            node.planes[3 + a][lane] = v[src as usize].max[a];
+                        }
+                    }
+                }
+            }
+        }
+        _ => out.wide = wide_nodes(&out.nodes),
+    }
     out
 }
 
@@ -69,6 +88,17 @@ fn refit_in_place_is_a_fresh_fit() {
                     bvh.refit(next).unwrap();
                     assert!(bvh == want, "{layout:?}, leaves of {leaf}");
                     assert_eq!(bvh.wide.len(), want.wide.len());
+                    // Whatever the wide topology, the tree bounds every box it holds.
+                    assert!(bvh.check_primitives(next).is_ok());
+                    for (i, b) in next.iter().enumerate() {
+                        let mut seen = false;
+                        let d = b.max - b.min + Vec3::splat(1.0);
+                        bvh.for_each_candidate_on_ray_ordered(b.min - d, d, 1.0e9, |p, _| {
+                            seen |= p as usize == i;
+                            true
+                        });
+                        assert!(seen, "{layout:?}, leaves of {leaf}: box {i} lost");
+                    }
                 }
             }
         }

@@ -14,7 +14,7 @@
 use super::build::{build_with_leaves, BuildOutput, MAX_LEAF_SIZE};
 use super::quantize::Quantization;
 use super::traverse::{right_child_of, with_nodes, NodeSet, QNodes};
-use super::wide::{collapse, collapse_into, WideNodes};
+use super::wide::{collapse, collapse_into, refit_real, WideNodes};
 use crate::error::{CaromError, Result};
 use crate::math::{Aabb, Real, Vec3, EPSILON};
 use serde::{Deserialize, Serialize};
@@ -322,7 +322,9 @@ impl Bvh {
     }
 
     /// Refits the boxes to new primitive boxes (same count, same topology), re-quantising
-    /// against the new bounds. Query results afterwards equal those of a fresh build.
+    /// against the new bounds. Query results afterwards equal those of a fresh build. The
+    /// quantised layout collapses its 4-wide nodes again (the same as a fresh build's); the
+    /// unquantised one keeps their topology and rewrites their boxes.
     pub fn refit(&mut self, boxes: &[Aabb]) -> Result<()> {
         check_boxes(boxes)?;
         if boxes.len() != self.order.len() {
@@ -355,8 +357,9 @@ impl Bvh {
                 for (n, a) in v.iter_mut().zip(&aabbs) {
                     *n = unquantized_node(a, n.data);
                 }
+                // The wide nodes keep their topology (see `refit_real`).
                 if let WideNodes::Unquantized(w) = &mut self.wide {
-                    collapse_into(v.as_slice(), w);
+                    refit_real(w, v);
                 }
             }
         }

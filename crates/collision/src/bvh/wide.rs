@@ -51,11 +51,12 @@ const EMPTY_NODE: WideNode = WideNode {
 };
 
 /// Four child boxes in [`Real`] coordinates and their references: the 4-wide node of the
-/// unquantised layout (112 bytes in `f32`, two cache lines). The boxes are the binary
+/// unquantised layout (128 bytes in `f32`, two cache lines). The boxes are the binary
 /// nodes' boxes (padded outward by a few ulps), plane by plane as in [`WideNode`], so the
-/// slab test loads each plane as it is: no conversion, and a refit writes them without
-/// quantising. Small trees that are refitted often (the world query's tree over the
-/// bodies) use this layout.
+/// slab test loads each plane as it is: no conversion. Each lane also names the binary node
+/// it copies (in what would otherwise be padding), so a refit rewrites the planes from the
+/// refitted binary nodes without collapsing again. Small trees that are refitted often (the
+/// world query's tree over the bodies) use this layout.
 #[repr(C, align(64))]
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct WideRealNode {
@@ -64,6 +65,8 @@ pub struct WideRealNode {
     pub planes: [[Real; 4]; 6],
     /// Child references, as in [`WideNode::children`].
     pub children: [u32; 4],
+    /// The binary node each lane's box is taken from (`u32::MAX` for an unused lane).
+    pub sources: [u32; 4],
 }
 
 const EMPTY_REAL_NODE: WideRealNode = WideRealNode {
@@ -76,6 +79,7 @@ const EMPTY_REAL_NODE: WideRealNode = WideRealNode {
         [-Real::MAX; 4],
     ],
     children: [EMPTY; 4],
+    sources: [EMPTY; 4],
 };
 
 /// The 4-wide nodes of a hierarchy, in its layout's coordinates.
@@ -175,6 +179,7 @@ impl WideSource for [UnquantizedNode] {
             w.planes[a][lane] = self[i].min[a];
             w.planes[3 + a][lane] = self[i].max[a];
         }
+        w.sources[lane] = i as u32;
     }
     #[inline(always)]
     fn children(w: &mut WideRealNode) -> &mut [u32; 4] {
@@ -241,6 +246,22 @@ pub(crate) fn collapse_into<S: WideSource + ?Sized>(nodes: &S, wide: &mut Vec<S:
             };
         }
         wide[w] = node;
+    }
+}
+
+/// Rewrites the planes of unquantised wide nodes from the binary nodes their lanes name
+/// (after a refit of those nodes): the collapse's topology is kept, as the refit keeps the
+/// binary one.
+pub(crate) fn refit_real(wide: &mut [WideRealNode], nodes: &[UnquantizedNode]) {
+    for w in wide {
+        for lane in 0..4 {
+            if let Some(n) = nodes.get(w.sources[lane] as usize) {
+                for a in 0..3 {
+                    w.planes[a][lane] = n.min[a];
+                    w.planes[3 + a][lane] = n.max[a];
+                }
+            }
+        }
     }
 }
 
