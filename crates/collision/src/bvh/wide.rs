@@ -1,4 +1,6 @@
-//! A 4-wide view of the quantised BVH for closest-hit rays.
+//! A 4-wide view of the BVH for closest-hit rays, in either node layout: [`WideNode`] for
+//! the quantised one, [`WideRealNode`] for the unquantised one (the same collapse and walk,
+//! generic over [`WideSource`] and [`WideBoxes`]).
 //!
 //! The binary, depth-first, stackless layout (`static_bvh`) is compact and ideal for box and
 //! point queries, but a closest-hit ray pays one dependent cache miss per visited level: the
@@ -12,9 +14,9 @@
 //! per node, boxes stored per axis); the collapse takes the child of largest area first, as
 //! Jolt's `AABBTreeBuilder` does when it turns a binary tree into a quad tree.
 //!
-//! The wide nodes reuse the quantised boxes of the binary nodes bit for bit (same
-//! quantisation, same outward rounding) and the same leaves, so they are as conservative as
-//! the binary layout; leaves still hold primitive ranges of `Bvh::order`. The slab test
+//! The wide nodes reuse the boxes of the binary nodes bit for bit (same quantisation and
+//! outward rounding, or the same ulp-padded `Real` boxes) and the same leaves, so they are
+//! as conservative as the binary layout; leaves still hold primitive ranges of `Bvh::order`. The slab test
 //! picks the near and far plane of each axis by the sign of the ray direction once per ray
 //! (Williams et al., "An Efficient and Robust Ray–Box Intersection Algorithm", JGT 2005),
 //! and scales the exit distance as Ize's robust test (`traverse::ROBUST_EXIT`).
@@ -63,7 +65,7 @@ pub struct WideRealNode {
     /// Child boxes plane by plane: min x, min y, min z, max x, max y, max z; lane `k` is
     /// child `k`. Unused lanes hold an inverted box.
     pub planes: [[Real; 4]; 6],
-    /// Child references, as in [`WideNode::children`].
+    /// Child references, as in the `children` of a [`WideNode`].
     pub children: [u32; 4],
     /// The binary node each lane's box is taken from (`u32::MAX` for an unused lane).
     pub sources: [u32; 4],
