@@ -61,8 +61,13 @@ pub fn draw(all: &[Summary], path: &Path) -> Result<(), String> {
                 String::new()
             }
         })
-        // Labels at 1, 2 and 5 times a power of ten only: the log scale's key points put
-        // two labels a hair apart at each decade ("10.0" printed twice, overlapping).
+        // Enough key points for plotters' log scale to place the light ones at 2..9 times
+        // each power of ten (with its default of 10 it keeps the powers only)...
+        .y_labels(40)
+        // The key points are the log grid's lines; no lighter lines between them.
+        .y_max_light_lines(0)
+        // ...and labels at 1, 2 and 5 times a power of ten only (the key points also put two
+        // labels a hair apart at each decade: "10.0" printed twice, overlapping).
         .y_label_formatter(&|y| {
             let decade = 10f64.powf(y.log10().floor());
             let m = y / decade;
