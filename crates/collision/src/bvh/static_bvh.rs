@@ -70,8 +70,9 @@ pub(crate) enum Nodes {
 
 /// A static BVH over primitive boxes (triangles, heightfield cells, compound children).
 /// Build with [`Bvh::new`]; query with the traversals in `bvh::traverse`. Serialised without
-/// its 4-wide nodes, which are derived from the binary ones when loading.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+/// its 4-wide nodes, which are derived from the binary ones when loading; equality compares
+/// what is serialised (see the `PartialEq` impl).
+#[derive(Debug, Clone, Serialize, Deserialize)]
 #[serde(try_from = "BvhData", into = "BvhData")]
 pub struct Bvh {
     pub(crate) nodes: Nodes,
@@ -82,6 +83,16 @@ pub struct Bvh {
     /// The nodes collapsed to 4-wide nodes for closest-hit rays (`bvh::wide`), in the
     /// layout's coordinates; empty when the root is a leaf.
     pub(crate) wide: WideNodes,
+}
+
+/// Equal binary nodes, primitive order and bounds: what a hierarchy serialises. The 4-wide
+/// nodes are derived from those and left out: a refitted unquantised tree keeps the wide
+/// topology of its build, where a loaded copy collapses afresh (possibly pulling up other
+/// grandchildren), and both answer every query alike.
+impl PartialEq for Bvh {
+    fn eq(&self, other: &Self) -> bool {
+        self.nodes == other.nodes && self.order == other.order && self.bounds == other.bounds
+    }
 }
 
 /// The serialised form of a [`Bvh`]: everything but the derived 4-wide nodes. Loading checks
