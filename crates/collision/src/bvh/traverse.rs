@@ -416,8 +416,9 @@ pub(crate) fn right_child_of<N: NodeSet>(ns: &N, i: usize) -> usize {
 
 /// Deferred far children of the ordered ray walk: an inline array, spilling to the heap only
 /// for trees deeper than it (degenerate inputs), so no allocation per ray. The inline array
-/// is left uninitialised (`SmallVec`): zeroing the 384 bytes of the array of 48 it replaced was a `memset` call per walk,
-/// 84 instructions of a world ray's ~5,500 for each of its two walks.
+/// is left uninitialised (`SmallVec`): zeroing the 384 bytes of the array of 48 it replaced
+/// was a `memset` call per walk, 84 instructions of a world ray's ~5,500 for each of its two
+/// walks.
 pub(crate) struct RayStack(SmallVec<[(u32, Real); 64]>);
 
 impl RayStack {

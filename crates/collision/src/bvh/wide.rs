@@ -16,7 +16,8 @@
 //!
 //! The wide nodes reuse the boxes of the binary nodes bit for bit (same quantisation and
 //! outward rounding, or the same ulp-padded `Real` boxes) and the same leaves, so they are
-//! as conservative as the binary layout; leaves still hold primitive ranges of `Bvh::order`. The slab test
+//! as conservative as the binary layout; leaves still hold primitive ranges of
+//! `Bvh::order`. The slab test
 //! picks the near and far plane of each axis by the sign of the ray direction once per ray
 //! (Williams et al., "An Efficient and Robust Ray–Box Intersection Algorithm", JGT 2005),
 //! and scales the exit distance as Ize's robust test (`traverse::ROBUST_EXIT`).

@@ -4,8 +4,9 @@
 //! The broadphase answers box-overlap pairs over boxes of the last step's poses, fattened
 //! by speculative margins (and a method without a tree has no ray walk at all), so a query
 //! builds a [`Bvh`] (binned SAH, 4-wide nodes of `f32` boxes, `carom_collision::midphase`)
-//! over the bodies' current world boxes, then walks it closest-first: a ray visits the nearer child first and shrinks its `max_t` at every
-//! hit (Bullet's `btDbvt::rayTestInternal`, Jolt's `CastRay` with a closest-hit collector),
+//! over the bodies' current world boxes, then walks it closest-first: a ray visits the
+//! nearer child first and shrinks its `max_t` at every hit (Bullet's
+//! `btDbvt::rayTestInternal`, Jolt's `CastRay` with a closest-hit collector),
 //! so the exact `query::raycast` runs on few shapes; a shape cast visits the leaves whose
 //! boxes meet the cast shape's box swept by its motion. Building is `O(N log N)`; a
 //! [`WorldQuery`] keeps the tree for many queries against the same state (the batch form
