@@ -110,6 +110,15 @@ impl WideNodes {
     }
 }
 
+/// Writes a box (`min`, `max`) into lane `lane` of a wide node's planes.
+#[inline(always)]
+fn put_lane<T: Copy>(planes: &mut [[T; 4]; 6], lane: usize, min: &[T; 3], max: &[T; 3]) {
+    for a in 0..3 {
+        planes[a][lane] = min[a];
+        planes[3 + a][lane] = max[a];
+    }
+}
+
 /// Binary nodes that collapse into 4-wide ones.
 pub(crate) trait WideSource {
     /// The wide node they collapse into.
@@ -147,10 +156,7 @@ impl WideSource for [QuantizedNode] {
     }
     #[inline(always)]
     fn set_lane(&self, w: &mut WideNode, lane: usize, i: usize) {
-        for a in 0..3 {
-            w.planes[a][lane] = self[i].min[a];
-            w.planes[3 + a][lane] = self[i].max[a];
-        }
+        put_lane(&mut w.planes, lane, &self[i].min, &self[i].max);
     }
     #[inline(always)]
     fn children(w: &mut WideNode) -> &mut [u32; 4] {
@@ -178,10 +184,7 @@ impl WideSource for [UnquantizedNode] {
     }
     #[inline(always)]
     fn set_lane(&self, w: &mut WideRealNode, lane: usize, i: usize) {
-        for a in 0..3 {
-            w.planes[a][lane] = self[i].min[a];
-            w.planes[3 + a][lane] = self[i].max[a];
-        }
+        put_lane(&mut w.planes, lane, &self[i].min, &self[i].max);
         w.sources[lane] = i as u32;
     }
     #[inline(always)]
@@ -259,10 +262,7 @@ pub(crate) fn refit_real(wide: &mut [WideRealNode], nodes: &[UnquantizedNode]) {
     for w in wide {
         for lane in 0..4 {
             if let Some(n) = nodes.get(w.sources[lane] as usize) {
-                for a in 0..3 {
-                    w.planes[a][lane] = n.min[a];
-                    w.planes[3 + a][lane] = n.max[a];
-                }
+                put_lane(&mut w.planes, lane, &n.min, &n.max);
             }
         }
     }
