@@ -99,6 +99,11 @@ pub struct ContactEvent<H> {
 #[derive(Debug, Clone)]
 pub struct NarrowPhase<H: Ord> {
     pairs: Vec<PairContact<H>>,
+    /// `(a, b)` of every pair, in pair order: the searches of a step's changes read these
+    /// 16 bytes per pair (L2-resident for tens of thousands of pairs) instead of striding
+    /// through the 192-byte pairs. On "3000 fall" (~16 k pairs, ~150 added and ~100
+    /// removed a step), the changes took 0.33–0.48 ms a step instead of 0.47–0.60.
+    keys: Vec<(H, H)>,
     sensors: BTreeSet<H>,
     /// Excluded object pairs `(lower, higher)`, sorted ([`NarrowPhase::set_excluded`]).
     excluded: Vec<(H, H)>,
@@ -120,6 +125,7 @@ impl<H: Ord> Default for NarrowPhase<H> {
     fn default() -> Self {
         NarrowPhase {
             pairs: Vec::new(),
+            keys: Vec::new(),
             sensors: BTreeSet::new(),
             excluded: Vec::new(),
             events: Vec::new(),
@@ -213,7 +219,7 @@ impl<H: Copy + Ord + Send + Sync> NarrowPhase<H> {
     }
 
     fn find(&self, a: H, b: H) -> std::result::Result<usize, usize> {
-        self.pairs.binary_search_by(|p| (p.a, p.b).cmp(&(a, b)))
+        self.keys.binary_search(&(a, b))
     }
 
     /// Creates the manifold of pair `(a, b)` (nothing when it exists).
@@ -222,6 +228,7 @@ impl<H: Copy + Ord + Send + Sync> NarrowPhase<H> {
             let mut p = new_pair(a, b);
             p.excluded = is_in(&self.excluded, a, b);
             self.pairs.insert(i, p);
+            self.keys.insert(i, (a, b));
         }
     }
 
@@ -272,6 +279,7 @@ impl<H: Copy + Ord + Send + Sync> NarrowPhase<H> {
     pub fn remove_pair(&mut self, a: H, b: H) {
         if let Ok(i) = self.find(a, b) {
             let p = self.pairs.remove(i);
+            self.keys.remove(i);
             if p.touching {
                 self.events.push(ContactEvent {
                     a,
@@ -305,15 +313,15 @@ impl<H: Copy + Ord + Send + Sync> NarrowPhase<H> {
         }
         self.dead.sort_unstable();
         self.dead.dedup();
-        let (pairs, dead) = (&mut self.pairs, &self.dead);
+        let (pairs, keys, dead) = (&mut self.pairs, &mut self.keys, &self.dead);
         // A pair removed and added again in the same step is created afresh.
         self.fresh.clear();
-        self.fresh.extend(added.iter().copied().filter(|&(a, b)| {
-            match pairs.binary_search_by(|p| (p.a, p.b).cmp(&(a, b))) {
+        self.fresh.extend(added.iter().copied().filter(
+            |&(a, b)| match keys.binary_search(&(a, b)) {
                 Ok(i) => dead.binary_search(&i).is_ok(),
                 Err(_) => true,
-            }
-        }));
+            },
+        ));
         if dead.is_empty() && self.fresh.is_empty() {
             return;
         }
@@ -330,7 +338,7 @@ impl<H: Copy + Ord + Send + Sync> NarrowPhase<H> {
         let pos = |j: usize| {
             fresh
                 .get(j)
-                .map_or(n, |&k| pairs.partition_point(|p| (p.a, p.b) < k))
+                .map_or(n, |&k| keys.partition_point(|&p| p < k))
         };
         let (mut src, mut out, mut di, mut fj) = (0, 0, 0, 0);
         let mut nf = pos(0);
@@ -359,17 +367,21 @@ impl<H: Copy + Ord + Send + Sync> NarrowPhase<H> {
         if out > n {
             let (a0, b0) = fresh[0];
             pairs.resize_with(out, || new_pair(a0, b0));
+            keys.resize(out, (a0, b0));
         }
         // Runs moving down go first, lowest first; runs moving up then, highest first: a
         // run's destination then holds only removed pairs, vacated slots or new slots.
         for &(s, e, d) in runs.iter().filter(|r| r.2 < r.0) {
             move_run_down(pairs, s, e, d);
+            move_run_down(keys, s, e, d);
         }
         for &(s, e, d) in runs.iter().rev().filter(|r| r.2 > r.0) {
             move_run_up(pairs, s, e, d);
+            move_run_up(keys, s, e, d);
         }
         for (&w, &(a, b)) in slots.iter().zip(fresh) {
             // Reuses the removed pair's point buffer when there is one.
+            keys[w] = (a, b);
             let p = &mut pairs[w];
             p.a = a;
             p.b = b;
@@ -379,6 +391,7 @@ impl<H: Copy + Ord + Send + Sync> NarrowPhase<H> {
             p.excluded = is_in(&self.excluded, a, b);
         }
         pairs.truncate(out);
+        keys.truncate(out);
     }
 
     /// One step: pairs `removed` are dropped and `added` created, then every manifold is
@@ -397,6 +410,7 @@ impl<H: Copy + Ord + Send + Sync> NarrowPhase<H> {
     {
         self.events.clear();
         self.apply_changes(added, removed);
+        debug_assert!(self.pairs.iter().map(|p| (p.a, p.b)).eq(self.keys.iter().copied()));
         let dispatcher = &self.dispatcher;
         let sensors = &self.sensors;
         let update = |p: &mut PairContact<H>, was: &mut bool| -> Result<()> {
@@ -492,6 +506,18 @@ impl<H: Copy + Ord + Send + Sync> NarrowPhase<H> {
     /// Mutable manifolds in pair order (for the solver to store accumulated impulses).
     pub fn manifolds_mut(&mut self) -> impl Iterator<Item = &mut PairContact<H>> {
         self.pairs.iter_mut().filter(|p| !p.manifold.is_empty())
+    }
+
+    /// Every pair with its manifold, in pair order, as a slice (to cut it into chunks).
+    pub fn pair_slice(&self) -> &[PairContact<H>] {
+        &self.pairs
+    }
+
+    /// Every pair, mutable, in pair order, as a slice (to write impulses back in parallel).
+    /// Only the manifolds and flags are meant to be written: changing a pair's `a` or `b`
+    /// breaks the pair order the narrowphase searches.
+    pub fn pair_slice_mut(&mut self) -> &mut [PairContact<H>] {
+        &mut self.pairs
     }
 
     /// Every pair, mutable, in pair order (to restore saved manifolds from a snapshot).
