@@ -21,7 +21,7 @@
 
 use super::World;
 use crate::body::{mix_friction, mix_restitution, BodyType};
-use crate::body_set::{BodyHandle, BodySet};
+use crate::body_set::{BodyHandle, BodyInfo, BodySet};
 use crate::contact::ContactManifold;
 use carom_collision::math::{orthonormal_basis, Real, Vec3};
 use carom_collision::narrowphase::PairContact;
@@ -40,36 +40,271 @@ impl World {
             body_of,
             contacts,
             sources,
+            chunk_counts,
             ..
         } = self;
-        let pairs = collision.narrowphase().pairs();
-        gather_pairs(dynamics.bodies(), body_of, pairs, contacts, sources)
+        let pairs = collision.narrowphase().pair_slice();
+        gather_pairs_chunked(
+            dynamics.bodies(),
+            body_of,
+            pairs,
+            contacts,
+            sources,
+            chunk_counts,
+            GATHER_CHUNK,
+        )
     }
 
     /// Stores the solver's impulses into the narrowphase points the contacts came from.
     #[inline(never)] // its own entry in profiles
     pub(super) fn write_back(&mut self) {
         let (contacts, sources) = (&self.contacts, &self.sources);
-        let mut pairs = self.collision.narrowphase_mut().pairs_mut();
-        // Index of the next pair `pairs` yields.
-        let mut next = 0;
-        for (m, &index) in contacts.iter().zip(sources) {
-            let index = index as usize;
-            let Some(pc) = pairs.nth(index - next) else {
-                break;
-            };
-            next = index + 1;
-            for (p, q) in pc.manifold.points.iter_mut().zip(m.points()) {
-                p.normal_impulse = q.normal_impulse;
-                p.tangent_impulse = [q.tangent_impulse[0], -q.tangent_impulse[1]];
-            }
-        }
+        let pairs = self.collision.narrowphase_mut().pair_slice_mut();
+        write_back_range(contacts, sources, pairs, 0, GATHER_CHUNK);
     }
 
     /// Number of contact points handed to the solver at the last step.
     pub(super) fn contact_point_count(&self) -> usize {
         self.contacts.iter().map(|m| m.points().len()).sum()
     }
+}
+
+/// Pairs per chunk of the parallel gather, and manifolds per task of the parallel write-back
+/// (a chunk of pairs, ~100 kB, stays in a core's L2 cache between the gather's two passes).
+pub(super) const GATHER_CHUNK: usize = 512;
+
+/// Stores `contacts`' impulses into the narrowphase points they came from: `sources[k]` is
+/// the index in `pairs` (which starts at pair `base`) of `contacts[k]`'s pair, ascending. In
+/// halves run by `rayon::join` down to `chunk` manifolds (the `parallel` feature): the
+/// sources split the pairs into disjoint ranges, so the writes do not depend on the thread
+/// count.
+pub(super) fn write_back_range(
+    contacts: &[ContactManifold],
+    sources: &[u32],
+    pairs: &mut [PairContact<ObjectHandle>],
+    base: usize,
+    chunk: usize,
+) {
+    #[cfg(feature = "parallel")]
+    if contacts.len() > chunk.max(1) {
+        let mid = contacts.len() / 2;
+        let split = (sources[mid] as usize - base).min(pairs.len());
+        let (c0, c1) = contacts.split_at(mid);
+        let (s0, s1) = sources.split_at(mid);
+        let (p0, p1) = pairs.split_at_mut(split);
+        rayon::join(
+            || write_back_range(c0, s0, p0, base, chunk),
+            || write_back_range(c1, s1, p1, base + split, chunk),
+        );
+        return;
+    }
+    let _ = chunk;
+    for (m, &index) in contacts.iter().zip(sources) {
+        let Some(pc) = pairs.get_mut(index as usize - base) else {
+            break;
+        };
+        for (p, q) in pc.manifold.points.iter_mut().zip(m.points()) {
+            p.normal_impulse = q.normal_impulse;
+            p.tangent_impulse = [q.tangent_impulse[0], -q.tangent_impulse[1]];
+        }
+    }
+}
+
+/// The bodies of a narrowphase pair whose manifold is handed to the solver: a non-empty,
+/// non-sensor manifold between two distinct live bodies, one of them dynamic. Reads the
+/// pair's header only (not its points).
+#[inline(always)]
+fn solver_bodies<'s>(
+    set: &'s BodySet,
+    body_of: &[Option<BodyHandle>],
+    pc: &PairContact<ObjectHandle>,
+) -> Option<(BodyHandle, BodyHandle, &'s BodyInfo, &'s BodyInfo)> {
+    if pc.manifold.points.is_empty() || pc.sensor {
+        return None;
+    }
+    let body = |o: ObjectHandle| body_of.get(o.index as usize).copied().flatten();
+    let (ba, bb) = (body(pc.a)?, body(pc.b)?);
+    // One at a time: a tuple of the two `Result`s (with their error payloads) was built on
+    // the stack for every manifold (~30 instructions of copies).
+    let ia = set.slot(ba).ok()?;
+    let ib = set.slot(bb).ok()?;
+    let (info_a, info_b) = (&set.info[ia], &set.info[ib]);
+    let dynamic = |t: BodyType| t == BodyType::Dynamic;
+    if !(dynamic(info_a.body_type) || dynamic(info_b.body_type)) || ba == bb {
+        return None;
+    }
+    Some((ba, bb, info_a, info_b))
+}
+
+/// [`gather_pairs`] over the slice `pairs`, in chunks of `chunk` pairs run in parallel (the
+/// `parallel` feature, more than one thread, at least two chunks): a first pass counts each
+/// chunk's manifolds from the pairs' headers ([`solver_bodies`]) into `counts`, a second
+/// fills every chunk's own range of `contacts` and `sources` (halves run by `rayon::join`).
+/// The manifolds are those of the serial pass, bit for bit, whatever the thread count. A
+/// manifold whose normal the serial pass would drop (not finite or not unit: a range would
+/// keep a hole) sends the whole gather to the serial pass.
+pub(super) fn gather_pairs_chunked(
+    set: &BodySet,
+    body_of: &[Option<BodyHandle>],
+    pairs: &[PairContact<ObjectHandle>],
+    contacts: &mut Vec<ContactManifold>,
+    sources: &mut Vec<u32>,
+    counts: &mut Vec<u32>,
+    chunk: usize,
+) -> bool {
+    gather_parallel(set, body_of, pairs, (contacts, sources), counts, chunk)
+        .unwrap_or_else(|| gather_pairs(set, body_of, pairs.iter(), contacts, sources))
+}
+
+/// The parallel passes of [`gather_pairs_chunked`], or `None` when they did not run (one
+/// thread, fewer than two chunks, no `parallel` feature) or a manifold was dropped for its
+/// normal.
+pub(super) fn gather_parallel(
+    set: &BodySet,
+    body_of: &[Option<BodyHandle>],
+    pairs: &[PairContact<ObjectHandle>],
+    (contacts, sources): (&mut Vec<ContactManifold>, &mut Vec<u32>),
+    counts: &mut Vec<u32>,
+    chunk: usize,
+) -> Option<bool> {
+    #[cfg(feature = "parallel")]
+    {
+        use rayon::prelude::*;
+        let chunk = chunk.max(1);
+        if rayon::current_num_threads() > 1 && pairs.len() >= 2 * chunk {
+            pairs
+                .par_chunks(chunk)
+                .map(|c| {
+                    c.iter()
+                        .filter(|pc| solver_bodies(set, body_of, pc).is_some())
+                        .count() as u32
+                })
+                .collect_into_vec(counts);
+            // Exclusive prefix sums: each chunk's first manifold.
+            let mut total = 0u32;
+            for c in counts.iter_mut() {
+                (*c, total) = (total, total + *c);
+            }
+            let total = total as usize;
+            let placeholder = BodyHandle {
+                index: 0,
+                generation: 0,
+            };
+            contacts.resize(
+                total,
+                ContactManifold::new(placeholder, placeholder, Vec3::Z),
+            );
+            sources.resize(total, 0);
+            let (sum, ok) =
+                fill_chunks(set, body_of, pairs, (contacts, sources), (counts, 0), chunk)?;
+            return Some(sum.is_finite() && ok);
+        }
+    }
+    let _ = (set, body_of, pairs, contacts, sources, counts, chunk);
+    None
+}
+
+/// The second pass of [`gather_pairs_chunked`] over the chunks whose first manifolds are
+/// `firsts.0` (the first chunk is chunk `firsts.1` of the whole slice): `out` holds exactly
+/// their manifolds and sources. Returns the sum and the range test of the values handed on,
+/// or `None` when a manifold was dropped for its normal.
+#[cfg(feature = "parallel")]
+fn fill_chunks(
+    set: &BodySet,
+    body_of: &[Option<BodyHandle>],
+    pairs: &[PairContact<ObjectHandle>],
+    out: (&mut [ContactManifold], &mut [u32]),
+    firsts: (&[u32], usize),
+    chunk: usize,
+) -> Option<(Real, bool)> {
+    let (contacts, sources) = out;
+    let (firsts, first_chunk) = firsts;
+    if firsts.len() > 1 {
+        let mid = firsts.len() / 2;
+        let split = (firsts[mid] - firsts[0]) as usize;
+        let (c0, c1) = contacts.split_at_mut(split);
+        let (s0, s1) = sources.split_at_mut(split);
+        let (f0, f1) = firsts.split_at(mid);
+        let (p0, p1) = pairs.split_at((mid * chunk).min(pairs.len()));
+        let (a, b) = rayon::join(
+            || fill_chunks(set, body_of, p0, (c0, s0), (f0, first_chunk), chunk),
+            || fill_chunks(set, body_of, p1, (c1, s1), (f1, first_chunk + mid), chunk),
+        );
+        let ((sa, oa), (sb, ob)) = (a?, b?);
+        return Some((sa + sb, oa && ob));
+    }
+    let base = first_chunk * chunk;
+    let mut k = 0;
+    let (mut sum, mut ok): (Real, bool) = (0.0, true);
+    for (index, pc) in pairs.iter().enumerate() {
+        let Some((ba, bb, info_a, info_b)) = solver_bodies(set, body_of, pc) else {
+            continue;
+        };
+        let m = contacts.get_mut(k)?;
+        let (values, ranges_ok) = fill_manifold(m, pc, (ba, bb), (info_a, info_b))?;
+        sum += values;
+        ok &= ranges_ok;
+        sources[k] = (base + index) as u32;
+        k += 1;
+    }
+    (k == contacts.len()).then_some((sum, ok))
+}
+
+/// Fills solver manifold `m` from narrowphase pair `pc` between bodies `ba`, `bb` (see
+/// [`gather_pairs`]): the points, the deepest point's normal (negated: A→B), the tangent and
+/// the mixed friction and restitution. Returns the sum of the values handed on and whether
+/// friction and restitution are in range, or `None` when the normal is not finite and unit
+/// (the manifold is then not handed on; its copied points stay unused).
+#[inline(always)]
+fn fill_manifold(
+    m: &mut ContactManifold,
+    pc: &PairContact<ObjectHandle>,
+    (ba, bb): (BodyHandle, BodyHandle),
+    (info_a, info_b): (&BodyInfo, &BodyInfo),
+) -> Option<(Real, bool)> {
+    let points = &pc.manifold.points[..];
+    let first = points.first()?;
+    // The deepest point (the first of equally deep ones), found while copying: the
+    // comparisons are those of a separate scan (`first` against itself is false).
+    let mut deepest = first;
+    let mut len = 0;
+    // This manifold's sum, counted only if the manifold is handed on.
+    let mut values: Real = 0.0;
+    for (q, p) in m.points.iter_mut().zip(points) {
+        if p.distance < deepest.distance {
+            deepest = p;
+        }
+        q.local_a = p.local_a;
+        q.local_b = p.local_b;
+        q.separation = p.distance;
+        q.feature_id = p.feature;
+        q.normal_impulse = p.normal_impulse;
+        q.tangent_impulse = [p.tangent_impulse[0], -p.tangent_impulse[1]];
+        values += (p.local_a + p.local_b).element_sum()
+            + ((p.distance + p.normal_impulse) + (p.tangent_impulse[0] + p.tangent_impulse[1]));
+        len += 1;
+    }
+    // More points than a solver manifold holds (not from the narrowphase, which keeps
+    // four): the deepest of all of them still gives the normal.
+    for p in points.get(len..).unwrap_or_default() {
+        if p.distance < deepest.distance {
+            deepest = p;
+        }
+    }
+    let n_b = deepest.normal;
+    if !n_b.is_finite() || (n_b.length_squared() - 1.0).abs() > 1e-3 {
+        return None;
+    }
+    let (t1, _) = orthonormal_basis(n_b);
+    m.len = len;
+    m.body_a = ba;
+    m.body_b = bb;
+    m.normal = -n_b;
+    m.tangent = t1;
+    m.friction = mix_friction(info_a.friction, info_b.friction);
+    m.restitution = mix_restitution(info_a.restitution, info_b.restitution);
+    let ranges_ok = m.friction >= 0.0 && (0.0..=1.0).contains(&m.restitution);
+    Some((values + m.friction, ranges_ok))
 }
 
 /// [`World::gather`] over `pairs` (the narrowphase's, in pair order): fills `contacts` and
@@ -89,81 +324,24 @@ pub(super) fn gather_pairs<'p>(
     contacts: &mut Vec<ContactManifold>,
     sources: &mut Vec<u32>,
 ) -> bool {
-    let body = |o: ObjectHandle| body_of.get(o.index as usize).copied().flatten();
     let mut k = 0;
     let mut sum: Real = 0.0;
     let mut ranges_ok = true;
     for (index, pc) in pairs.enumerate() {
-        let points = &pc.manifold.points[..];
-        let Some(first) = points.first() else {
+        let Some((ba, bb, info_a, info_b)) = solver_bodies(set, body_of, pc) else {
             continue;
         };
-        if pc.sensor {
-            continue;
-        }
-        let (Some(ba), Some(bb)) = (body(pc.a), body(pc.b)) else {
-            continue;
-        };
-        // One at a time: a tuple of the two `Result`s (with their error payloads) was
-        // built on the stack for every manifold (~30 instructions of copies).
-        let Ok(ia) = set.slot(ba) else {
-            continue;
-        };
-        let Ok(ib) = set.slot(bb) else {
-            continue;
-        };
-        let (info_a, info_b) = (&set.info[ia], &set.info[ib]);
-        let dynamic = |t: BodyType| t == BodyType::Dynamic;
-        if !(dynamic(info_a.body_type) || dynamic(info_b.body_type)) || ba == bb {
-            continue;
-        }
         if k == contacts.len() {
             contacts.push(ContactManifold::new(ba, bb, Vec3::Z));
             sources.push(0);
         }
-        let m = &mut contacts[k];
-        // The deepest point (the first of equally deep ones), found while copying: the
-        // comparisons are those of a separate scan (`first` against itself is false).
-        let mut deepest = first;
-        let mut len = 0;
-        // This manifold's sum, counted only if the manifold is handed on.
-        let mut values: Real = 0.0;
-        for (q, p) in m.points.iter_mut().zip(points) {
-            if p.distance < deepest.distance {
-                deepest = p;
-            }
-            q.local_a = p.local_a;
-            q.local_b = p.local_b;
-            q.separation = p.distance;
-            q.feature_id = p.feature;
-            q.normal_impulse = p.normal_impulse;
-            q.tangent_impulse = [p.tangent_impulse[0], -p.tangent_impulse[1]];
-            values += (p.local_a + p.local_b).element_sum()
-                + ((p.distance + p.normal_impulse) + (p.tangent_impulse[0] + p.tangent_impulse[1]));
-            len += 1;
-        }
-        // More points than a solver manifold holds (not from the narrowphase, which keeps
-        // four): the deepest of all of them still gives the normal.
-        for p in points.get(len..).unwrap_or_default() {
-            if p.distance < deepest.distance {
-                deepest = p;
-            }
-        }
-        let n_b = deepest.normal;
-        if !n_b.is_finite() || (n_b.length_squared() - 1.0).abs() > 1e-3 {
-            // The copied points stay unused: entry `k` is refilled or truncated.
+        // A manifold dropped for its normal leaves entry `k` to be refilled or truncated.
+        let Some((values, ok)) = fill_manifold(&mut contacts[k], pc, (ba, bb), (info_a, info_b))
+        else {
             continue;
-        }
-        let (t1, _) = orthonormal_basis(n_b);
-        m.len = len;
-        m.body_a = ba;
-        m.body_b = bb;
-        m.normal = -n_b;
-        m.tangent = t1;
-        m.friction = mix_friction(info_a.friction, info_b.friction);
-        m.restitution = mix_restitution(info_a.restitution, info_b.restitution);
-        sum += values + m.friction;
-        ranges_ok &= m.friction >= 0.0 && (0.0..=1.0).contains(&m.restitution);
+        };
+        sum += values;
+        ranges_ok &= ok;
         sources[k] = index as u32;
         k += 1;
     }

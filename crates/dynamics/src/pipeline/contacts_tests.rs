@@ -4,7 +4,7 @@
 //! manifold holds), ties for the deepest point, NaN and infinite values in every field,
 //! signed zeros, values far from the origin, and non-unit normals.
 
-use super::contacts::gather_pairs;
+use super::contacts::{gather_pairs, gather_pairs_chunked, gather_parallel, write_back_range};
 use crate::body::{mix_friction, mix_restitution, BodyDesc, BodyType};
 use crate::body_set::tests::real_bits;
 use crate::body_set::{BodyHandle, BodySet};
@@ -207,7 +207,12 @@ fn gather_pairs_is_the_reference_bit_for_bit() {
         .collect();
     let (mut fast, mut fast_src) = (Vec::new(), Vec::new());
     let (mut slow, mut slow_src) = (Vec::new(), Vec::new());
-    let (mut trues, mut falses, mut handed) = (0, 0, 0);
+    let (mut trues, mut falses, mut handed, mut parallel) = (0, 0, 0, 0);
+    let (mut chunked, mut chunked_src, mut counts) = (Vec::new(), Vec::new(), Vec::new());
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(3)
+        .build()
+        .unwrap();
     for round in 0..400 {
         let mut pairs = Vec::new();
         for _ in 0..rng.below(24) {
@@ -288,6 +293,56 @@ fn gather_pairs_is_the_reference_bit_for_bit() {
         // The flag: the same unless a sum of finite values overflowed (the values here stay
         // below 10³⁰ times four terms, far from it).
         assert_eq!(ok_fast, ok_slow, "round {round}");
+        // The chunked gather (parallel passes, or the serial pass it falls back to) hands on
+        // the same manifolds, for chunks of one pair up.
+        for chunk in [1, 2, 5] {
+            let ok = pool.install(|| {
+                let (c, s) = (&mut chunked, &mut chunked_src);
+                if gather_parallel(&set, &body_of, &pairs, (c, s), &mut counts, chunk).is_some() {
+                    parallel += 1;
+                }
+                gather_pairs_chunked(&set, &body_of, &pairs, c, s, &mut counts, chunk)
+            });
+            assert_eq!(chunked_src, fast_src, "round {round}, chunk {chunk}");
+            assert_eq!(chunked.len(), fast.len(), "round {round}, chunk {chunk}");
+            for (f, c) in fast.iter().zip(&chunked) {
+                assert_eq!(bits(f), bits(c), "round {round}, chunk {chunk}");
+            }
+            assert_eq!(ok, ok_fast, "round {round}, chunk {chunk}");
+        }
+        // The write-back in halves stores every manifold's impulses into its own pair, as
+        // an indexed loop does (the second friction impulse negated).
+        for (k, m) in fast.iter_mut().enumerate() {
+            for (i, p) in m.points.iter_mut().enumerate() {
+                p.normal_impulse = (round * 100 + k * 10 + i) as Real;
+                p.tangent_impulse = [rng.real(), -0.0];
+            }
+        }
+        let mut expected = pairs.clone();
+        for (m, &src) in fast.iter().zip(&fast_src) {
+            let points = &mut expected[src as usize].manifold.points;
+            for (p, q) in points.iter_mut().zip(&m.points[..m.len]) {
+                p.normal_impulse = q.normal_impulse;
+                p.tangent_impulse = [q.tangent_impulse[0], -q.tangent_impulse[1]];
+            }
+        }
+        for chunk in [1, 3, 64] {
+            let mut written = pairs.clone();
+            pool.install(|| write_back_range(&fast, &fast_src, &mut written, 0, chunk));
+            for (w, e) in written.iter().zip(&expected) {
+                let imp = |p: &PairContact<ObjectHandle>| {
+                    p.manifold
+                        .points
+                        .iter()
+                        .flat_map(|q| {
+                            [q.normal_impulse, q.tangent_impulse[0], q.tangent_impulse[1]]
+                        })
+                        .map(real_bits)
+                        .collect::<Vec<_>>()
+                };
+                assert_eq!(imp(w), imp(e), "round {round}, chunk {chunk}");
+            }
+        }
         if ok_fast {
             trues += 1;
         } else {
@@ -297,7 +352,7 @@ fn gather_pairs_is_the_reference_bit_for_bit() {
     }
     // The generator reaches both answers and hands manifolds on.
     assert!(
-        trues > 50 && falses > 50 && handed > 1000,
-        "{trues} {falses} {handed}"
+        trues > 50 && falses > 50 && handed > 1000 && parallel > 300,
+        "{trues} {falses} {handed} {parallel}"
     );
 }

@@ -113,6 +113,8 @@ pub struct World {
     contacts: Vec<ContactManifold>,
     /// For each entry of `contacts`, the index of its narrowphase pair (see `contacts.rs`).
     sources: Vec<u32>,
+    /// Per chunk of pairs, its first manifold (reused buffer of the parallel gather).
+    chunk_counts: Vec<u32>,
     /// Time not yet simulated by [`World::step_simulation`].
     accumulator: Real,
     report: PipelineReport,
@@ -139,6 +141,7 @@ impl World {
             resting: Vec::new(),
             contacts: Vec::new(),
             sources: Vec::new(),
+            chunk_counts: Vec::new(),
             accumulator: 0.0,
             report: PipelineReport::default(),
             query_cache: Default::default(),
