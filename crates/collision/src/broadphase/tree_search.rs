@@ -89,7 +89,7 @@ impl TreeBroadPhase {
 
 /// Moved proxies per chunk of the parallel incremental search; the chunked path is taken
 /// from two chunks up (fewer moved proxies do not pay a fork).
-pub(super) const MOVED_CHUNK: usize = 256;
+pub(super) const MOVED_CHUNK: usize = 64;
 
 /// The full search is split into parallel tasks from this many leaves of the moving tree.
 pub(super) const PARALLEL_MIN_LEAVES: usize = 512;
@@ -159,7 +159,7 @@ impl Part {
 /// Surviving candidates per chunk of the parallel candidate merge; the merge is split from
 /// two chunks up.
 #[cfg(feature = "parallel")]
-const MERGE_CHUNK: usize = 4096;
+const MERGE_CHUNK: usize = 2048;
 
 /// One chunk's reused buffers in the parallel candidate merge.
 #[derive(Debug, Clone, Default)]
@@ -174,7 +174,7 @@ pub(super) struct MergePart {
 /// [`PairView::unchanged`] and not found again, and pushes the candidates whose exact boxes
 /// overlap and whose filters accept to `exact` ([`PairView::emit`]); both outputs sorted.
 ///
-/// From two chunks of `MERGE_CHUNK` (4096) surviving candidates up and on more than one thread
+/// From two chunks of `MERGE_CHUNK` (2048) surviving candidates up and on more than one thread
 /// (with the `parallel` feature), `old` is cut at fixed
 /// positions and `new` at the first key of each chunk (a binary search), so each chunk
 /// holds every key of its key range; the chunks are merged in parallel with the `parallel`

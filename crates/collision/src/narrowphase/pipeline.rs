@@ -410,7 +410,11 @@ impl<H: Copy + Ord + Send + Sync> NarrowPhase<H> {
     {
         self.events.clear();
         self.apply_changes(added, removed);
-        debug_assert!(self.pairs.iter().map(|p| (p.a, p.b)).eq(self.keys.iter().copied()));
+        debug_assert!(self
+            .pairs
+            .iter()
+            .map(|p| (p.a, p.b))
+            .eq(self.keys.iter().copied()));
         let dispatcher = &self.dispatcher;
         let sensors = &self.sensors;
         let update = |p: &mut PairContact<H>, was: &mut bool| -> Result<()> {
