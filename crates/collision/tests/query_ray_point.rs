@@ -421,3 +421,77 @@ fn solid_hull_casts_equal_the_full_interval() {
         "{hits} hits, {inside_hits} inside"
     );
 }
+
+/// An unrotated pose takes the cast's translation-only path (`pose.rotation ==
+/// Quat::IDENTITY`); the same rotation written as `-IDENTITY` takes the general path, which
+/// rotates the ray into the shape's frame and the hit back. Both give the same hits (the
+/// identity rotation changes no value but the sign of a zero, which `==` ignores): convex
+/// shapes, a plane, a triangle and a mesh, translations near and far, random rays and rays
+/// along the axes with signed zeros.
+#[test]
+fn unrotated_poses_take_the_translation_path_with_the_same_hits() {
+    use carom_collision::math::Quat;
+    use carom_collision::shape::TriMesh;
+    let mut rng = Rng(0x5eed_1d3e);
+    let mut all = shapes(&mut rng);
+    all.push(Shape::Plane(Plane::new(Vec3::Y, 0.25).unwrap()));
+    all.push(Shape::Triangle(
+        Triangle::new(Vec3::ZERO, Vec3::X, Vec3::Z).unwrap(),
+    ));
+    let mut vertices = Vec::new();
+    let mut indices = Vec::new();
+    for i in 0..6u32 {
+        for k in 0..6u32 {
+            vertices.push(Vec3::new(i as Real, rng.range(-0.2, 0.2), k as Real) - 2.5);
+        }
+    }
+    for i in 0..5u32 {
+        for k in 0..5u32 {
+            let v = i * 6 + k;
+            indices.push([v, v + 1, v + 6]);
+            indices.push([v + 1, v + 7, v + 6]);
+        }
+    }
+    all.push(Shape::TriMesh(TriMesh::new(vertices, indices).unwrap()));
+    let flipped = -Quat::IDENTITY;
+    assert!(flipped != Quat::IDENTITY);
+    let (mut hits, mut cases) = (0, 0);
+    for shape in &all {
+        for &reach in &[0.0, 3.0, 1.0e3] {
+            let t = rng.vec(reach);
+            let (fast, slow) = (Isometry::new(t, Quat::IDENTITY), Isometry::new(t, flipped));
+            // Random rays, and rays aimed near the shape's origin.
+            let mut rays: Vec<(Vec3, Vec3)> = (0..60)
+                .map(|k| {
+                    let o = t + rng.vec(3.0);
+                    let aim = (t + rng.vec(0.3) - o).normalize_or(Vec3::Y);
+                    (o, if k % 2 == 0 { rng.unit() } else { aim })
+                })
+                .collect();
+            for axis in [Vec3::X, Vec3::Y, Vec3::Z] {
+                for s in [1.0, -1.0] {
+                    let d = axis * s + Vec3::new(-0.0, -0.0, -0.0);
+                    rays.push((t - d * 4.0 + Vec3::new(0.1, 0.05, -0.0), d));
+                }
+            }
+            for (o, d) in rays {
+                for solid in [true, false] {
+                    let a = raycast(shape, &fast, o, d, 50.0, solid).unwrap();
+                    let b = raycast(shape, &slow, o, d, 50.0, solid).unwrap();
+                    cases += 1;
+                    match (a, b) {
+                        (None, None) => {}
+                        (Some(a), Some(b)) => {
+                            hits += 1;
+                            assert_eq!(a.distance.to_bits(), b.distance.to_bits(), "{shape:?}");
+                            assert!(a.point == b.point && a.normal == b.normal, "{a:?} {b:?}");
+                            assert_eq!((a.inside, a.feature), (b.inside, b.feature));
+                        }
+                        (a, b) => panic!("{shape:?} {o} {d}: {a:?} against {b:?}"),
+                    }
+                }
+            }
+        }
+    }
+    assert!(hits > cases / 3, "{hits} of {cases}");
+}

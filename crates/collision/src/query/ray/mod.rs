@@ -22,7 +22,7 @@ use self::gjk_ray::{gjk_raycast, Single};
 use super::result::RayHit;
 use super::support_adapters::Exact;
 use crate::error::{CaromError, Result};
-use crate::math::{check_finite_vec, Isometry, Real, Vec3};
+use crate::math::{check_finite_vec, Isometry, Quat, Real, Vec3};
 use crate::midphase::TriangleSource;
 use crate::shape::{ConvexRef, Shape};
 
@@ -100,6 +100,20 @@ fn raycast_posed(
     max_distance: Real,
     solid: bool,
 ) -> Option<RayHit> {
+    if pose.rotation == Quat::IDENTITY {
+        // An unrotated shape (a static mesh placed by translation, as the raytests
+        // landscape): the ray and the hit only move by the translation. Rotating by the
+        // identity gives the same values up to the sign of zeros; on the 500-ray batch the
+        // two rotations and the two back were ~120 instructions of every landscape cast.
+        let local = Ray {
+            origin: ray.origin - pose.translation,
+            dir: ray.dir,
+        };
+        return raycast_local(shape, &local, max_distance, solid).map(|h| RayHit {
+            point: h.point + pose.translation,
+            ..h
+        });
+    }
     let local = Ray {
         origin: pose.inverse_transform_point(ray.origin),
         dir: pose.inverse_transform_vector(ray.dir),
