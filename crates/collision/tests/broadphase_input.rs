@@ -4,6 +4,7 @@
 
 mod broadphase_common;
 
+#[cfg(feature = "parallel")]
 use broadphase_common::{moved_box, random_box, Rng, Scene};
 use carom_collision::broadphase::{overlapping_pairs, AnyBroadPhase, BroadPhase, Filter, Method};
 use carom_collision::math::{Aabb, Real, Vec3};
@@ -116,8 +117,10 @@ proptest! {
 
 /// Runs a scene of motion for every method and returns the pairs and changes of each frame.
 /// Per frame: the pairs, the number added, the number removed.
+#[cfg(feature = "parallel")]
 type Frames = Vec<(Vec<(u32, u32)>, usize, usize)>;
 
+#[cfg(feature = "parallel")]
 fn record(method: Method, n: usize, frames: usize) -> Frames {
     let mut rng = Rng(42);
     let mut bp = AnyBroadPhase::new(method);

@@ -3,6 +3,7 @@
 //! pairs a brute force finds, on scenes large enough to take the parallel paths: every
 //! proxy moved (full descent), many moved (chunked queries), few moved (the serial loop);
 //! on 2 and 8 threads the merge of the candidates is split into chunks too.
+#![cfg(feature = "parallel")]
 
 mod broadphase_common;
 
