@@ -75,9 +75,9 @@ pub(super) const GATHER_CHUNK: usize = 512;
 
 /// Stores `contacts`' impulses into the narrowphase points they came from: `sources[k]` is
 /// the index in `pairs` (which starts at pair `base`) of `contacts[k]`'s pair, ascending. In
-/// halves run by `rayon::join` down to `chunk` manifolds (the `parallel` feature): the
-/// sources split the pairs into disjoint ranges, so the writes do not depend on the thread
-/// count.
+/// halves run by `rayon::join` down to `chunk` manifolds (the `parallel` feature, more than
+/// one thread): the sources split the pairs into disjoint ranges, so the writes do not
+/// depend on the thread count.
 pub(super) fn write_back_range(
     contacts: &[ContactManifold],
     sources: &[u32],
@@ -86,7 +86,7 @@ pub(super) fn write_back_range(
     chunk: usize,
 ) {
     #[cfg(feature = "parallel")]
-    if contacts.len() > chunk.max(1) {
+    if contacts.len() > chunk.max(1) && rayon::current_num_threads() > 1 {
         let mid = contacts.len() / 2;
         let split = (sources[mid] as usize - base).min(pairs.len());
         let (c0, c1) = contacts.split_at(mid);
