@@ -3,7 +3,10 @@
 //! rays), printing the median time per batch and a checksum of the hits. A small target for
 //! `valgrind --tool=callgrind` when working on world ray casts.
 //!
-//! `cargo run --release -p carom-dynamics --example ray_batch -- [steps] [batches]`
+//! `cargo run --release -p carom-dynamics --example ray_batch -- [steps] [batches] [warm]`
+//!
+//! With `warm`, no step runs between the batches: the batch finds the caches as the last
+//! batch left them, which tells how much of its time is memory traffic.
 
 use carom_dynamics::{PipelineParams, World};
 
@@ -11,6 +14,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut args = std::env::args().skip(1);
     let steps: usize = args.next().and_then(|s| s.parse().ok()).unwrap_or(300);
     let batches: usize = args.next().and_then(|s| s.parse().ok()).unwrap_or(200);
+    let warm = args.next().is_some_and(|s| s == "warm");
     let scene = carom_scenes::bullet::scene(7).ok_or("no scene 7")?;
     let mut params = PipelineParams::default();
     params.dynamics.sleep.enabled = false;
@@ -26,7 +30,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     for _ in 0..batches {
         // A step between batches, as in the benchmark: the query's tree is refitted or
         // rebuilt for the moved bodies.
-        pool.install(|| world.step(1.0 / 60.0))?;
+        if !warm {
+            pool.install(|| world.step(1.0 / 60.0))?;
+        }
         let t = std::time::Instant::now();
         let query = world.query()?;
         build.push(t.elapsed().as_secs_f64() * 1e3);
