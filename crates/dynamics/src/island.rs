@@ -109,27 +109,38 @@ pub(crate) fn needed(set: &BodySet, params: &SleepParams, dt: Real) -> bool {
     })
 }
 
-/// Computes the island root of every body slot into `scratch.roots`.
+/// Touching body pairs (slots) of the step: the manifolds with points, then `resting`,
+/// the touching pairs the pipeline did not hand to the solver because neither body is awake
+/// (see `pipeline::contacts::resting_edges`).
+fn touching<'a>(
+    manifolds: &'a [ContactManifold],
+    resting: &'a [(usize, usize)],
+) -> impl Iterator<Item = (usize, usize)> + 'a {
+    manifolds
+        .iter()
+        .filter(|m| !m.points().is_empty())
+        .map(|m| (m.body_a.index as usize, m.body_b.index as usize))
+        .chain(resting.iter().copied())
+}
+
+/// Computes the island root of every body slot into `scratch.roots`, joining bodies through
+/// the manifolds with points, the `resting` pairs and the unbroken joints.
 #[inline(never)] // its own entry in profiles
 pub(crate) fn build(
     set: &BodySet,
-    manifolds: &[ContactManifold],
+    (manifolds, resting): (&[ContactManifold], &[(usize, usize)]),
     joints: &JointSet,
     scratch: &mut IslandScratch,
 ) {
     let parent = &mut scratch.roots;
     parent.clear();
     parent.extend(0..set.capacity());
-    let edges = manifolds
-        .iter()
-        .filter(|m| !m.points().is_empty())
-        .map(|m| (m.body_a.index as usize, m.body_b.index as usize))
-        .chain(
-            joints
-                .iter()
-                .filter(|(_, j)| !j.broken)
-                .map(|(_, j)| (j.desc.body_a.index as usize, j.desc.body_b.index as usize)),
-        );
+    let edges = touching(manifolds, resting).chain(
+        joints
+            .iter()
+            .filter(|(_, j)| !j.broken)
+            .map(|(_, j)| (j.desc.body_a.index as usize, j.desc.body_b.index as usize)),
+    );
     for (a, b) in edges {
         if is_dynamic(set, a) && is_dynamic(set, b) {
             union(parent, a, b);
@@ -149,7 +160,7 @@ pub(crate) fn build(
 pub(crate) fn wake_islands(
     set: &mut BodySet,
     scratch: &mut IslandScratch,
-    manifolds: &[ContactManifold],
+    (manifolds, resting): (&[ContactManifold], &[(usize, usize)]),
 ) -> Vec<BodyHandle> {
     let roots = &scratch.roots;
     let awake = &mut scratch.awake;
@@ -165,9 +176,12 @@ pub(crate) fn wake_islands(
             && (set.linear_velocity[i] != Vec3::ZERO || set.angular_velocity[i] != Vec3::ZERO);
     }
     // The contacts matter only when a kinematic body moves.
-    let touching = if moving_kinematic { manifolds } else { &[] };
-    for m in touching.iter().filter(|m| !m.points().is_empty()) {
-        let (a, b) = (m.body_a.index as usize, m.body_b.index as usize);
+    let (manifolds, resting) = if moving_kinematic {
+        (manifolds, resting)
+    } else {
+        (&[][..], &[][..])
+    };
+    for (a, b) in touching(manifolds, resting) {
         for (k, d) in [(a, b), (b, a)] {
             let kinematic = set.is_alive(k) && set.info[k].body_type == BodyType::Kinematic;
             let moving =

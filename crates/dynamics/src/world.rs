@@ -50,6 +50,22 @@ impl Default for WorldParams {
     }
 }
 
+/// A step between [`DynamicsWorld::begin_step`] and [`DynamicsWorld::finish_step`]: when it
+/// began, whether islands were built, and the report so far (the woken bodies).
+#[derive(Debug)]
+pub(crate) struct BegunStep {
+    start: Instant,
+    islands: bool,
+    report: StepReport,
+}
+
+impl BegunStep {
+    /// Bodies woken so far (by contacts, joints or user calls).
+    pub(crate) fn woken(&self) -> &[BodyHandle] {
+        &self.report.woken
+    }
+}
+
 /// What changed during a step.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct StepReport {
@@ -230,10 +246,52 @@ impl DynamicsWorld {
         contacts: &mut [ContactManifold],
         checked: bool,
     ) -> Result<StepReport> {
+        let begun = self.begin_step(dt, contacts, checked, &[])?;
+        self.finish_step(dt, contacts, begun, None)
+    }
+
+    /// The first part of a step: checks everything (nothing changes on an error), then
+    /// builds the islands from the contacts with points, the `resting` pairs (body slots
+    /// touching without a manifold handed on) and the joints, and wakes the sleeping islands
+    /// that hold an awake body. [`DynamicsWorld::finish_step`] solves with the contacts; the
+    /// pipeline gathers them again between the two when this woke a body, since it hands
+    /// only the manifolds of awake bodies to the solver.
+    pub(crate) fn begin_step(
+        &mut self,
+        dt: Real,
+        contacts: &[ContactManifold],
+        checked: bool,
+        resting: &[(usize, usize)],
+    ) -> Result<BegunStep> {
         let start = Instant::now();
         if !(dt.is_finite() && dt > 0.0) {
             return Err(CaromError::invalid("dt", dt, "must be finite and > 0"));
         }
+        self.check_contacts(contacts, checked)?;
+        for (jh, j) in self.joints.iter() {
+            if !self.bodies.contains(j.desc.body_a) || !self.bodies.contains(j.desc.body_b) {
+                return Err(CaromError::UnknownHandle(format!("a body of joint {jh:?}")));
+            }
+        }
+        let mut report = StepReport::default();
+        let islands = island::needed(&self.bodies, &self.params.sleep, dt);
+        if islands {
+            let touching = (contacts, resting);
+            island::build(&self.bodies, touching, &self.joints, &mut self.islands);
+            report.woken = island::wake_islands(&mut self.bodies, &mut self.islands, touching);
+        } else {
+            report.woken = island::user_woken(&mut self.bodies);
+        }
+        report.timings.islands = start.elapsed();
+        Ok(BegunStep {
+            start,
+            islands,
+            report,
+        })
+    }
+
+    /// Every manifold's checks (see [`DynamicsWorld::step_gathered`] for `checked`).
+    fn check_contacts(&self, contacts: &[ContactManifold], checked: bool) -> Result<()> {
         for (k, m) in contacts.iter().enumerate() {
             // The full check (which names the bad value) only for a manifold that fails the
             // cheap one; both accept the same manifolds, the cheap one possibly fewer.
@@ -243,21 +301,29 @@ impl DynamicsWorld {
                 m.validate(k, &self.bodies)?;
             }
         }
-        for (jh, j) in self.joints.iter() {
-            if !self.bodies.contains(j.desc.body_a) || !self.bodies.contains(j.desc.body_b) {
-                return Err(CaromError::UnknownHandle(format!("a body of joint {jh:?}")));
-            }
-        }
-        let mut report = StepReport::default();
-        let islands = island::needed(&self.bodies, &self.params.sleep, dt);
-        if islands {
-            island::build(&self.bodies, contacts, &self.joints, &mut self.islands);
-            report.woken = island::wake_islands(&mut self.bodies, &mut self.islands, contacts);
-        } else {
-            report.woken = island::user_woken(&mut self.bodies);
-        }
-        report.timings.islands = start.elapsed();
+        Ok(())
+    }
 
+    /// The rest of a step begun by [`DynamicsWorld::begin_step`] with the same `dt`:
+    /// integration, the solver and sleeping, with `contacts`: those of `begin_step`
+    /// (`regathered` `None`), or gathered again after it woke bodies (`Some(checked)`,
+    /// checked as `begin_step` checks; an error then leaves the woken bodies awake and
+    /// changes nothing else).
+    pub(crate) fn finish_step(
+        &mut self,
+        dt: Real,
+        contacts: &mut [ContactManifold],
+        begun: BegunStep,
+        regathered: Option<bool>,
+    ) -> Result<StepReport> {
+        let BegunStep {
+            start,
+            islands,
+            mut report,
+        } = begun;
+        if let Some(checked) = regathered {
+            self.check_contacts(contacts, checked)?;
+        }
         integrate::load(&self.bodies, &mut self.solver_bodies);
         let mut ctx = StepContext {
             set: &mut self.bodies,

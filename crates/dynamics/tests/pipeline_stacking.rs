@@ -30,15 +30,7 @@ fn run(w: &mut World, boxes: &[BodyHandle], n_steps: usize, name: &str) -> (Real
 fn ten_box_stack_stands_for_2000_steps() {
     let mut w = world(false);
     ground(&mut w, 0.5);
-    let boxes: Vec<BodyHandle> = (0..10)
-        .map(|i| {
-            dyn_box(
-                &mut w,
-                Vec3::splat(0.5),
-                Vec3::new(0.0, 0.5 + i as Real, 0.0),
-            )
-        })
-        .collect();
+    let boxes = box_column(&mut w, 10);
     let (settle, drift) = run(&mut w, &boxes, 2000, "stack10");
     assert!(
         drift < 0.01 && settle < 0.05,

@@ -31,9 +31,11 @@ impl World {
     /// Fills `self.contacts` from the narrowphase (see the module docs). Returns true when
     /// every manifold is certainly valid for the solver (the checks of
     /// [`crate::DynamicsWorld::step`] hold), false when one may not be (the step then
-    /// validates them all and names the bad value).
+    /// validates them all and names the bad value). Only manifolds with an awake dynamic
+    /// body are handed on; with `resting`, the touching pairs left out for that reason go to
+    /// `self.resting_pairs` for the islands (cleared otherwise; see [`resting_edges`]).
     #[inline(never)] // its own entry in profiles
-    pub(super) fn gather(&mut self) -> bool {
+    pub(super) fn gather(&mut self, resting: bool) -> bool {
         let World {
             dynamics,
             collision,
@@ -41,15 +43,17 @@ impl World {
             contacts,
             sources,
             chunk_counts,
+            resting_pairs,
             ..
         } = self;
         let pairs = collision.narrowphase().pair_slice();
+        resting_pairs.clear();
         gather_pairs_chunked(
             dynamics.bodies(),
             body_of,
             pairs,
-            contacts,
-            sources,
+            (contacts, sources),
+            resting.then_some(resting_pairs),
             chunk_counts,
             GATHER_CHUNK,
         )
@@ -111,10 +115,75 @@ pub(super) fn write_back_range(
 }
 
 /// The bodies of a narrowphase pair whose manifold is handed to the solver: a non-empty,
-/// non-sensor manifold between two distinct live bodies, one of them dynamic. Reads the
-/// pair's header only (not its points).
+/// non-sensor manifold between two distinct live bodies, one of them dynamic and awake (the
+/// solver selects exactly those; a sleeping body is not moved, so a pile that sleeps hands
+/// nothing on: its pairs go to the islands alone, see [`resting_edges`]). Reads the pair's
+/// header only (not its points).
 #[inline(always)]
 fn solver_bodies<'s>(
+    set: &'s BodySet,
+    body_of: &[Option<BodyHandle>],
+    pc: &PairContact<ObjectHandle>,
+) -> Option<(BodyHandle, BodyHandle, &'s BodyInfo, &'s BodyInfo)> {
+    let (ba, bb, info_a, info_b) = touching_bodies(set, body_of, pc)?;
+    (awake(info_a) || awake(info_b)).then_some((ba, bb, info_a, info_b))
+}
+
+/// The touching pairs whose manifold the gather leaves out only because neither body is
+/// awake (a sleeping body against a sleeping, static or kinematic one), as body slots,
+/// appended to `out`: the islands still join bodies through them, so a sleeping pile wakes
+/// whole. The same pairs as the gather would hand on with every body awake (normal check
+/// included).
+pub(super) fn resting_edges(
+    set: &BodySet,
+    body_of: &[Option<BodyHandle>],
+    pairs: &[PairContact<ObjectHandle>],
+    out: &mut Vec<(usize, usize)>,
+) {
+    for pc in pairs {
+        if let Some((ba, bb, info_a, info_b)) = touching_bodies(set, body_of, pc) {
+            push_resting(out, pc, (ba, bb), (info_a, info_b));
+        }
+    }
+}
+
+/// A body is awake for the solver: dynamic and not sleeping.
+#[inline(always)]
+fn awake(i: &BodyInfo) -> bool {
+    i.body_type == BodyType::Dynamic && !i.sleeping
+}
+
+/// Appends the touching pair `pc` of bodies `ba`, `bb` to `out` when neither is awake and
+/// its manifold would pass the gather's normal check.
+#[inline(always)]
+fn push_resting(
+    out: &mut Vec<(usize, usize)>,
+    pc: &PairContact<ObjectHandle>,
+    (ba, bb): (BodyHandle, BodyHandle),
+    (info_a, info_b): (&BodyInfo, &BodyInfo),
+) {
+    if !(awake(info_a) || awake(info_b)) && unit_deepest_normal(&pc.manifold.points) {
+        out.push((ba.index as usize, bb.index as usize));
+    }
+}
+
+/// True when the deepest point's normal (the first of equally deep ones) is finite and
+/// unit, as [`fill_manifold`] requires of a manifold it hands on.
+fn unit_deepest_normal(points: &[carom_collision::narrowphase::ContactPoint]) -> bool {
+    let Some(first) = points.first() else {
+        return false;
+    };
+    let deepest = points
+        .iter()
+        .fold(first, |d, p| if p.distance < d.distance { p } else { d });
+    let n = deepest.normal;
+    n.is_finite() && (n.length_squared() - 1.0).abs() <= 1e-3
+}
+
+/// [`solver_bodies`] without the awake test: a non-empty, non-sensor manifold between two
+/// distinct live bodies, one of them dynamic.
+#[inline(always)]
+fn touching_bodies<'s>(
     set: &'s BodySet,
     body_of: &[Option<BodyHandle>],
     pc: &PairContact<ObjectHandle>,
@@ -143,17 +212,27 @@ fn solver_bodies<'s>(
 /// The manifolds are those of the serial pass, bit for bit, whatever the thread count. A
 /// manifold whose normal the serial pass would drop (not finite or not unit: a range would
 /// keep a hole) sends the whole gather to the serial pass.
+/// With `resting`, the touching pairs left out because neither body is awake are appended
+/// to it (in pair order): by the serial pass as it goes, or by [`resting_edges`] after the
+/// parallel passes.
 pub(super) fn gather_pairs_chunked(
     set: &BodySet,
     body_of: &[Option<BodyHandle>],
     pairs: &[PairContact<ObjectHandle>],
-    contacts: &mut Vec<ContactManifold>,
-    sources: &mut Vec<u32>,
+    (contacts, sources): (&mut Vec<ContactManifold>, &mut Vec<u32>),
+    resting: Option<&mut Vec<(usize, usize)>>,
     counts: &mut Vec<u32>,
     chunk: usize,
 ) -> bool {
-    gather_parallel(set, body_of, pairs, (contacts, sources), counts, chunk)
-        .unwrap_or_else(|| gather_pairs(set, body_of, pairs.iter(), contacts, sources))
+    match gather_parallel(set, body_of, pairs, (contacts, sources), counts, chunk) {
+        Some(checked) => {
+            if let Some(out) = resting {
+                resting_edges(set, body_of, pairs, out);
+            }
+            checked
+        }
+        None => gather_pairs(set, body_of, pairs.iter(), (contacts, sources), resting),
+    }
 }
 
 /// The parallel passes of [`gather_pairs_chunked`], or `None` when they did not run (one
@@ -321,16 +400,22 @@ pub(super) fn gather_pairs<'p>(
     set: &BodySet,
     body_of: &[Option<BodyHandle>],
     pairs: impl Iterator<Item = &'p PairContact<ObjectHandle>>,
-    contacts: &mut Vec<ContactManifold>,
-    sources: &mut Vec<u32>,
+    (contacts, sources): (&mut Vec<ContactManifold>, &mut Vec<u32>),
+    mut resting: Option<&mut Vec<(usize, usize)>>,
 ) -> bool {
     let mut k = 0;
     let mut sum: Real = 0.0;
     let mut ranges_ok = true;
     for (index, pc) in pairs.enumerate() {
-        let Some((ba, bb, info_a, info_b)) = solver_bodies(set, body_of, pc) else {
+        let Some((ba, bb, info_a, info_b)) = touching_bodies(set, body_of, pc) else {
             continue;
         };
+        if !(awake(info_a) || awake(info_b)) {
+            if let Some(out) = resting.as_deref_mut() {
+                push_resting(out, pc, (ba, bb), (info_a, info_b));
+            }
+            continue;
+        }
         if k == contacts.len() {
             contacts.push(ContactManifold::new(ba, bb, Vec3::Z));
             sources.push(0);

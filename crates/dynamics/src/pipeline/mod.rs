@@ -115,6 +115,9 @@ pub struct World {
     sources: Vec<u32>,
     /// Per chunk of pairs, its first manifold (reused buffer of the parallel gather).
     chunk_counts: Vec<u32>,
+    /// Body slots of the touching pairs not handed to the solver because neither body is
+    /// awake, for the islands (reused buffer, see `contacts::resting_edges`).
+    resting_pairs: Vec<(usize, usize)>,
     /// Time not yet simulated by [`World::step_simulation`].
     accumulator: Real,
     report: PipelineReport,
@@ -142,6 +145,7 @@ impl World {
             contacts: Vec::new(),
             sources: Vec::new(),
             chunk_counts: Vec::new(),
+            resting_pairs: Vec::new(),
             accumulator: 0.0,
             report: PipelineReport::default(),
             query_cache: Default::default(),

@@ -59,13 +59,26 @@ impl World {
         self.collision.update()?;
         let ct = self.collision.timings();
 
+        // Only the manifolds of awake bodies go to the solver; the islands also see the
+        // touching pairs of sleeping ones. When the islands wake bodies, their manifolds
+        // are gathered again before the solver runs.
         let t = Instant::now();
-        let checked = self.gather();
-        let gather = t.elapsed();
-
+        let islands =
+            crate::island::needed(self.dynamics.bodies(), &self.params.dynamics.sleep, dt);
+        let checked = self.gather(islands);
+        let mut gather = t.elapsed();
+        let begun = self
+            .dynamics
+            .begin_step(dt, &self.contacts, checked, &self.resting_pairs)?;
+        let regathered = (!begun.woken().is_empty()).then(|| {
+            let t = Instant::now();
+            let checked = self.gather(false);
+            gather += t.elapsed();
+            checked
+        });
         let dyn_report = self
             .dynamics
-            .step_gathered(dt, &mut self.contacts, checked)?;
+            .finish_step(dt, &mut self.contacts, begun, regathered)?;
 
         let t = Instant::now();
         self.write_back();

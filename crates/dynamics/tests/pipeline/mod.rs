@@ -42,6 +42,13 @@ pub fn dyn_box(w: &mut World, h: Vec3, p: Vec3) -> BodyHandle {
     .unwrap()
 }
 
+/// A column of `n` unit boxes standing on the ground, the lowest resting on it.
+pub fn box_column(w: &mut World, n: usize) -> Vec<BodyHandle> {
+    (0..n)
+        .map(|i| dyn_box(w, Vec3::splat(0.5), Vec3::new(0.0, 0.5 + i as Real, 0.0)))
+        .collect()
+}
+
 pub fn pos(w: &World, b: BodyHandle) -> Vec3 {
     w.bodies().center_of_mass(b).unwrap()
 }
