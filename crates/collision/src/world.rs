@@ -162,6 +162,9 @@ pub struct CollisionWorld {
     changes: WorldPairChanges,
     narrowphase: NarrowPhase<ObjectHandle>,
     timings: UpdateTimings,
+    /// Number of objects that are not resting: when none is, no manifold can change and
+    /// the narrowphase skips its shape tests (`NarrowPhase::step_with`).
+    active: usize,
 }
 
 impl CollisionWorld {
@@ -214,6 +217,7 @@ impl CollisionWorld {
         if i >= self.objects.len() {
             self.objects.resize(i + 1, None);
         }
+        self.active += usize::from(!filter.is_static);
         self.objects[i] = Some(CollisionObject {
             shape,
             pose,
@@ -386,7 +390,9 @@ impl CollisionWorld {
         self.broadphase.set_filter(h.proxy(), filter)?;
         let o = self.objects[i].as_mut().expect("slot checked");
         o.filter = filter;
+        let was = o.resting;
         o.resting |= filter.is_static;
+        self.active -= usize::from(o.resting && !was);
         Ok(())
     }
 
@@ -396,7 +402,9 @@ impl CollisionWorld {
         let i = self.slot(h)?;
         self.broadphase.set_resting(h.proxy(), resting)?;
         let o = self.objects[i].as_mut().expect("slot checked");
+        let was = o.resting;
         o.resting = resting || o.filter.is_static;
+        self.active = self.active + usize::from(was && !o.resting) - usize::from(o.resting && !was);
         Ok(())
     }
 
@@ -406,7 +414,9 @@ impl CollisionWorld {
         let i = self.slot(h)?;
         self.broadphase.remove_proxy(h.proxy())?;
         self.narrowphase.clear_exclusions_of(h);
-        Ok(self.objects[i].take().expect("slot checked"))
+        let o = self.objects[i].take().expect("slot checked");
+        self.active -= usize::from(!o.resting);
+        Ok(o)
     }
 
     /// Number of objects.
@@ -450,7 +460,7 @@ impl CollisionWorld {
         let mid = Instant::now();
         let objects = &self.objects;
         let (added, removed) = (&self.changes.added, &self.changes.removed);
-        self.narrowphase.step(added, removed, |h: ObjectHandle| {
+        let lookup = |h: ObjectHandle| {
             let o = objects.get(h.index as usize)?.as_ref()?;
             (o.handle == h).then_some(NarrowObject {
                 shape: &o.shape,
@@ -459,7 +469,13 @@ impl CollisionWorld {
                 motion: o.motion,
                 active: !o.resting,
             })
-        })?;
+        };
+        debug_assert_eq!(
+            self.active,
+            objects.iter().flatten().filter(|o| !o.resting).count()
+        );
+        self.narrowphase
+            .step_with(added, removed, lookup, self.active > 0)?;
         self.timings = UpdateTimings {
             broadphase: mid - start,
             narrowphase: mid.elapsed(),

@@ -536,3 +536,88 @@ fn refitting_and_reinserting_two_tree_broadphases_report_the_brute_force_pairs()
         assert!(total >= 10, "pairs changed: {total}");
     }
 }
+
+#[test]
+fn quiet_updates_report_the_brute_force_pairs() {
+    // An update after which nothing changed returns the last pairs without a pass over the
+    // candidates (a sleeping world); one change that marks no proxy moved must still be seen:
+    // a box shrunk inside its fat box, a filter's mask, a resting hint, a user filter.
+    use carom_collision::broadphase::{BroadPhase, BruteForce, Filter, TreeBroadPhase};
+    use std::sync::Arc;
+    // Two touching boxes; one pulled back by 1 % of its size (inside its fat box): the pair
+    // ends although no proxy moved in the tree.
+    let mut tree = TreeBroadPhase::new(InsertStrategy::SurfaceArea, 0.05);
+    let a = tree
+        .create_proxy(Aabb::new(Vec3::ZERO, Vec3::ONE), Filter::new(false))
+        .unwrap();
+    let b = Aabb::new(Vec3::new(1.0, 0.0, 0.0), Vec3::new(2.0, 1.0, 1.0));
+    tree.create_proxy(b, Filter::new(false)).unwrap();
+    assert_eq!(tree.update_pairs().added.len(), 1);
+    assert_eq!(tree.update_pairs().kept, 1);
+    let back = Aabb::new(Vec3::ZERO, Vec3::new(0.99, 1.0, 1.0));
+    tree.update_proxy(a, back, Vec3::ZERO).unwrap();
+    assert_eq!(tree.update_pairs().removed.len(), 1);
+    assert!(tree.pairs().is_empty());
+    for (k, &scene) in SCENES.iter().enumerate() {
+        let mut rng = Rng(1700 + k as u64);
+        let mut tree = TreeBroadPhase::new(InsertStrategy::SurfaceArea, 0.05);
+        let mut oracle = BruteForce::new();
+        let mut live = Vec::new();
+        for _ in 0..60 {
+            let (b, f) = (random_box(&mut rng, scene), Filter::new(rng.below(8) == 0));
+            let h = oracle.create_proxy(b, f).unwrap();
+            assert_eq!(tree.create_proxy(b, f).unwrap(), h);
+            live.push(h);
+        }
+        let mut quiet = 0;
+        for frame in 0..60 {
+            let h = live[rng.below(live.len())];
+            match frame % 6 {
+                0 => {}
+                1 => {
+                    // A proxy with a pair shrunk to a point at a corner: inside its fat box,
+                    // so not moved, but its pairs change.
+                    let h = oracle.pairs().first().map_or(h, |p| p.0);
+                    let b = oracle.aabb(h).unwrap();
+                    let nb = Aabb::new(b.min, b.min);
+                    oracle.update_proxy(h, nb, Vec3::ZERO).unwrap();
+                    tree.update_proxy(h, nb, Vec3::ZERO).unwrap();
+                }
+                2 => {
+                    let mut f = Filter::new(false);
+                    f.mask = if frame % 4 == 0 { 0 } else { u32::MAX };
+                    oracle.set_filter(h, f).unwrap();
+                    tree.set_filter(h, f).unwrap();
+                }
+                3 => tree.set_resting(h, frame % 4 == 1).unwrap(),
+                4 => {
+                    // A user filter rejecting pairs of even slots, then none.
+                    let uf: Option<carom_collision::broadphase::UserFilter> = (frame % 12 == 4)
+                        .then(|| {
+                            Arc::new(|a: _, b: _| {
+                                let (a, b): (
+                                    carom_collision::broadphase::ProxyHandle,
+                                    carom_collision::broadphase::ProxyHandle,
+                                ) = (a, b);
+                                (a.index + b.index) % 2 == 1
+                            }) as _
+                        });
+                    oracle.set_user_filter(uf.clone());
+                    tree.set_user_filter(uf);
+                }
+                _ => {
+                    let (nb, d) = moved_box(&mut rng, &oracle.aabb(h).unwrap(), scene);
+                    oracle.update_proxy(h, nb, d).unwrap();
+                    tree.update_proxy(h, nb, d).unwrap();
+                }
+            }
+            for _ in 0..2 {
+                let expect = oracle.update_pairs().clone();
+                quiet += usize::from(expect.added.is_empty() && expect.removed.is_empty());
+                assert_eq!(tree.update_pairs(), &expect, "frame {frame}");
+                assert_eq!(tree.pairs(), oracle.pairs(), "frame {frame}");
+            }
+        }
+        assert!(quiet >= 60, "{quiet} quiet updates");
+    }
+}

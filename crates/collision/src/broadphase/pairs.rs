@@ -186,6 +186,19 @@ impl PairCache {
         &self.changes
     }
 
+    /// Records an update that changed no pair: nothing added or removed, every pair kept.
+    pub fn keep_all(&mut self) -> &PairChanges {
+        self.changes.added.clear();
+        self.changes.removed.clear();
+        self.changes.kept = self.keys.len();
+        &self.changes
+    }
+
+    /// True when a user pair filter is installed.
+    pub fn has_user_filter(&self) -> bool {
+        self.user_filter.is_some()
+    }
+
     /// The current pairs as handles, sorted.
     pub fn pairs(&self, store: &ProxyStore) -> Vec<(ProxyHandle, ProxyHandle)> {
         self.keys

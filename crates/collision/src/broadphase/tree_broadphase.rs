@@ -69,6 +69,10 @@ pub struct TreeBroadPhase {
     merge_capacity: [usize; 2],
     /// A proxy was removed since the last update (its candidate pairs must be dropped).
     removed_since_update: bool,
+    /// A box or a filter changed since the last update (`update_proxy`, `set_filter`,
+    /// `set_user_filter`): a box may move inside its fat box without marking its proxy moved,
+    /// and its exact pairs must still be tested again.
+    changed: bool,
     /// Leaves re-inserted per update and tree by the incremental optimisation.
     pub optimize_per_update: usize,
     /// Fraction of moved proxies above which pairs are found by tree descent, not queries.
@@ -143,6 +147,7 @@ impl TreeBroadPhase {
             merge_parts: Vec::new(),
             merge_capacity: [0; 2],
             removed_since_update: false,
+            changed: false,
             optimize_per_update: 4,
             full_sweep_fraction: 0.5,
             wide_query_keys: 1.0,
@@ -204,6 +209,7 @@ impl TreeBroadPhase {
     #[inline]
     pub(crate) fn update_slot(&mut self, i: usize, aabb: &Aabb, displacement: Vec3) {
         self.store.set_aabb_trusted(i, *aabb);
+        self.changed = true;
         let (t, leaf) = self.leaves[i];
         if self.trees[t].needs_new_fat(leaf.index as usize, aabb, displacement) {
             self.set_new_fat(i, aabb, displacement);
@@ -309,6 +315,7 @@ impl BroadPhase for TreeBroadPhase {
         let i = self.store.check(proxy)?;
         let was_static = self.store.filters()[i].is_static;
         self.store.set_filter(proxy, filter)?;
+        self.changed = true;
         if filter.is_static && !was_static {
             self.migrate(i, RESTING);
         } else if !filter.is_static && was_static {
@@ -330,9 +337,24 @@ impl BroadPhase for TreeBroadPhase {
 
     fn set_user_filter(&mut self, filter: Option<super::UserFilter>) {
         self.cache.set_user_filter(filter);
+        self.changed = true;
     }
 
     fn update_pairs(&mut self) -> &PairChanges {
+        // No box, filter or proxy changed (and no user filter, which may answer differently
+        // from one update to the next): every candidate keeps its boxes and filters, so the
+        // pairs are the last update's (a world whose bodies all sleep).
+        if self.moved.is_empty()
+            && !self.removed_since_update
+            && !self.changed
+            && !self.cache.has_user_filter()
+        {
+            for t in &mut self.trees {
+                t.optimize_incremental(self.optimize_per_update);
+            }
+            return self.cache.keep_all();
+        }
+        self.changed = false;
         let mut moved = std::mem::take(&mut self.moved);
         moved.retain(|&m| self.store.is_alive(m as usize));
         moved.sort_unstable();

@@ -411,6 +411,24 @@ impl<H: Copy + Ord + Send + Sync> NarrowPhase<H> {
     where
         F: Fn(H) -> Option<NarrowObject<'s>> + Sync,
     {
+        self.step_with(added, removed, lookup, true)
+    }
+
+    /// [`NarrowPhase::step`], told whether any object may be active. With `any_active`
+    /// false (every object resting or static: a world whose bodies all sleep), no pair
+    /// can be updated, so none is looked up: excluded pairs are cleared, every other pair
+    /// keeps its state, and the events are those `step` would report (a touching pair
+    /// persists).
+    pub fn step_with<'s, F>(
+        &mut self,
+        added: &[(H, H)],
+        removed: &[(H, H)],
+        lookup: F,
+        any_active: bool,
+    ) -> Result<&[ContactEvent<H>]>
+    where
+        F: Fn(H) -> Option<NarrowObject<'s>> + Sync,
+    {
         self.events.clear();
         self.apply_changes(added, removed);
         debug_assert!(self
@@ -457,19 +475,26 @@ impl<H: Copy + Ord + Send + Sync> NarrowPhase<H> {
         let update = |p: &mut PairContact<H>, kind: &mut Option<ContactEventKind>| {
             let was = p.touching;
             update_pair(p)?;
-            *kind = match (was, p.touching) {
-                (false, true) => Some(ContactEventKind::Begin),
-                (true, true) => Some(ContactEventKind::Persist),
-                (true, false) => Some(ContactEventKind::End),
-                (false, false) => None,
-            };
+            *kind = event_kind(was, p.touching);
             Ok(())
         };
         let kinds = &mut self.event_kinds;
         kinds.clear();
         kinds.resize(self.pairs.len(), None);
+        if !any_active {
+            for (p, kind) in self.pairs.iter_mut().zip(kinds.iter_mut()) {
+                let was = p.touching;
+                if p.excluded {
+                    p.manifold.clear();
+                    p.touching = false;
+                }
+                *kind = event_kind(was, p.touching);
+            }
+        }
         #[cfg(feature = "parallel")]
-        let first_error = {
+        let first_error = if !any_active {
+            None
+        } else {
             use rayon::prelude::*;
             self.pairs
                 .par_iter_mut()
@@ -484,6 +509,7 @@ impl<H: Copy + Ord + Send + Sync> NarrowPhase<H> {
             .iter_mut()
             .zip(kinds.iter_mut())
             .enumerate()
+            .filter(|_| any_active)
             .find_map(|(i, (p, w))| update(p, w).err().map(|e| (i, e)));
         if let Some((_, e)) = first_error {
             return Err(e);
@@ -557,5 +583,15 @@ impl<H: Copy + Ord + Send + Sync> NarrowPhase<H> {
     /// True when there is no pair.
     pub fn is_empty(&self) -> bool {
         self.pairs.is_empty()
+    }
+}
+
+/// The event of a pair that was touching (`was`) and is now (`now`).
+fn event_kind(was: bool, now: bool) -> Option<ContactEventKind> {
+    match (was, now) {
+        (false, true) => Some(ContactEventKind::Begin),
+        (true, true) => Some(ContactEventKind::Persist),
+        (true, false) => Some(ContactEventKind::End),
+        (false, false) => None,
     }
 }
