@@ -123,6 +123,22 @@ fn touching<'a>(
         .chain(resting.iter().copied())
 }
 
+/// True when nothing can move or wake anything this step: every live dynamic body sleeps
+/// and no kinematic body moves (a body woken by a user call is awake). Islands would then
+/// wake nothing, and no manifold would reach the solver, so the step skips both.
+pub(crate) fn idle(set: &BodySet) -> bool {
+    (0..set.capacity()).all(|i| {
+        !set.is_alive(i)
+            || match set.info[i].body_type {
+                BodyType::Dynamic => set.info[i].sleeping,
+                BodyType::Kinematic => {
+                    set.linear_velocity[i] == Vec3::ZERO && set.angular_velocity[i] == Vec3::ZERO
+                }
+                BodyType::Static => true,
+            }
+    })
+}
+
 /// Computes the island root of every body slot into `scratch.roots`, joining bodies through
 /// the manifolds with points, the `resting` pairs and the unbroken joints.
 #[inline(never)] // its own entry in profiles

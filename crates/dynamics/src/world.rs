@@ -274,7 +274,8 @@ impl DynamicsWorld {
             }
         }
         let mut report = StepReport::default();
-        let islands = island::needed(&self.bodies, &self.params.sleep, dt);
+        let islands =
+            island::needed(&self.bodies, &self.params.sleep, dt) && !island::idle(&self.bodies);
         if islands {
             let touching = (contacts, resting);
             island::build(&self.bodies, touching, &self.joints, &mut self.islands);

@@ -62,10 +62,19 @@ impl World {
         // Only the manifolds of awake bodies go to the solver; the islands also see the
         // touching pairs of sleeping ones. When the islands wake bodies, their manifolds
         // are gathered again before the solver runs.
+        // A world whose dynamic bodies all sleep (no kinematic body moving) hands nothing on
+        // and wakes nothing: no gather, no islands (`island::idle`).
         let t = Instant::now();
-        let islands =
-            crate::island::needed(self.dynamics.bodies(), &self.params.dynamics.sleep, dt);
-        let checked = self.gather(islands);
+        let bodies = self.dynamics.bodies();
+        let checked = if crate::island::idle(bodies) {
+            self.contacts.clear();
+            self.sources.clear();
+            self.resting_pairs.clear();
+            true
+        } else {
+            let islands = crate::island::needed(bodies, &self.params.dynamics.sleep, dt);
+            self.gather(islands)
+        };
         let mut gather = t.elapsed();
         let begun = self
             .dynamics
