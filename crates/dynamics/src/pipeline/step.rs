@@ -60,10 +60,10 @@ impl World {
         let ct = self.collision.timings();
 
         // Only the manifolds of awake bodies go to the solver; the islands also see the
-        // touching pairs of sleeping ones. When the islands wake bodies, their manifolds
-        // are gathered again before the solver runs.
-        // A world whose dynamic bodies all sleep (no kinematic body moving) hands nothing on
-        // and wakes nothing: no gather, no islands (`island::idle`).
+        // touching pairs of sleeping ones, and when they wake bodies, the manifolds are
+        // gathered again before the solver runs. A world whose dynamic bodies all sleep (no
+        // kinematic body moving) hands nothing on and wakes nothing: no gather, no islands
+        // (`island::idle`).
         let t = Instant::now();
         let bodies = self.dynamics.bodies();
         let checked = if crate::island::idle(bodies) {
