@@ -1,6 +1,6 @@
 # Carom: the two commands of the README, and the pieces they are made of.
 #   make demo   build and run a real example
-#   make test   every check CI runs (fmt, clippy, cargo test f32 + f64, Python package + pytest)
+#   make test   every check CI runs (fmt, clippy, cargo test f32 + f64 + serial, Python package + pytest)
 #   make bench  Bullet's benchmark scenes: Carom, Rapier and Bullet (pybullet) side by side
 # Everything Python lives in a local venv (.venv) that these targets create.
 
@@ -15,7 +15,7 @@ export CARGO_TERM_COLOR ?= never
 # less to build from a clean checkout), everything else `release`.
 CAROM_PROFILE ?= release
 
-.PHONY: demo test fmt fmt-check lint rust-test rust-test-f64 rust-test-release python-test develop venv bench bench-venv toolchain clean
+.PHONY: demo test fmt fmt-check lint rust-test rust-test-f64 rust-test-serial rust-test-release python-test develop venv bench bench-venv toolchain clean
 
 toolchain:
 	@command -v $(CARGO) >/dev/null || { echo "error: cargo not found; install Rust (rustup) first"; exit 1; }
@@ -50,12 +50,18 @@ lint: toolchain
 	$(CARGO) clippy --workspace --all-targets -- -D warnings
 	# In the f64 build `x as Real` casts are no-ops by design.
 	$(CARGO) clippy --workspace --all-targets --features carom-collision/f64 -- -D warnings -A clippy::unnecessary_cast
+	# The serial build (no `parallel` feature) has cfg paths of its own.
+	$(CARGO) clippy -p carom-collision -p carom-dynamics --no-default-features --lib --tests -- -D warnings
 
 rust-test: toolchain
 	$(CARGO) test --workspace
 
 rust-test-f64: toolchain
 	$(CARGO) test --workspace --features carom-collision/f64
+
+# The serial build: the tests of the two crates whose code switches on `parallel`.
+rust-test-serial: toolchain
+	$(CARGO) test -p carom-collision -p carom-dynamics --no-default-features
 
 # The long stacking tests in a release build, where they run up to 10x the steps of the debug
 # build (`common::steps`): a creep that only showed after 400 steps went unseen (session 10).
@@ -68,7 +74,7 @@ python-test: develop
 	$(PY) -m mypy.stubtest carom._carom
 
 test: CAROM_PROFILE = ci
-test: fmt-check lint rust-test rust-test-f64 rust-test-release python-test
+test: fmt-check lint rust-test rust-test-f64 rust-test-serial rust-test-release python-test
 	@echo "make test: all checks passed"
 
 # The Bullet peer: pybullet from PyPI in its own venv (.venv-bench).

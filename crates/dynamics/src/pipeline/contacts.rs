@@ -118,7 +118,8 @@ pub(super) fn write_back_range(
 /// non-sensor manifold between two distinct live bodies, one of them dynamic and awake (the
 /// solver selects exactly those; a sleeping body is not moved, so a pile that sleeps hands
 /// nothing on: its pairs go to the islands alone, see [`resting_edges`]). Reads the pair's
-/// header only (not its points).
+/// header only (not its points). The serial gather tests the same in its own loop.
+#[cfg(feature = "parallel")]
 #[inline(always)]
 fn solver_bodies<'s>(
     set: &'s BodySet,
