@@ -3,7 +3,8 @@
 //! "(prepare)", is the part of "solver" that prepares the contacts and joints.
 //!
 //! `cargo run --release -p carom-dynamics --example stage_split -- [scene 1–8] [steps]
-//! [threads]`
+//! [threads] [sleep]` (`sleep` turns sleeping on; the figures then cover steps 300 on,
+//! when most bodies rest, and the last line counts the awake dynamic bodies).
 
 use carom_dynamics::{PipelineParams, World};
 
@@ -12,9 +13,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let number: usize = args.next().and_then(|s| s.parse().ok()).unwrap_or(2);
     let steps: usize = args.next().and_then(|s| s.parse().ok()).unwrap_or(300);
     let threads: usize = args.next().and_then(|s| s.parse().ok()).unwrap_or(1);
+    let sleep = args.next().is_some_and(|s| s == "sleep");
     let scene = carom_scenes::bullet::scene(number).ok_or("scene number must be 1–8")?;
     let mut params = PipelineParams::default();
-    params.dynamics.sleep.enabled = false;
+    params.dynamics.sleep.enabled = sleep;
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build()?;
@@ -32,8 +34,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     ];
     let mut t: Vec<Vec<f64>> = vec![vec![]; names.len()];
     let (mut pairs, mut manifolds, mut points) = (0, 0, 0);
-    for _ in 0..steps {
+    for step in 0..steps {
         let r = pool.install(|| world.step(1.0 / 60.0))?;
+        if sleep && step < 300 {
+            continue;
+        }
         let s = &r.timings;
         let all = [
             s.sync,
@@ -58,5 +63,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         println!("{n:>12}: {mean:.3} ms mean, {:.3} median", v[v.len() / 2]);
     }
     println!("last step: {pairs} pairs, {manifolds} manifolds, {points} contact points");
+    if sleep {
+        println!("sleeping bodies at the end: {}", world.sleeping_count());
+    }
     Ok(())
 }
