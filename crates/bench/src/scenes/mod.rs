@@ -9,6 +9,7 @@
 pub mod bullet_peer;
 pub mod carom_engine;
 pub mod chart;
+pub mod control;
 pub mod engine;
 pub mod export;
 pub mod inertia;
@@ -172,6 +173,8 @@ pub fn run(args: &Args) -> Result<(), String> {
     );
     let mut summaries = Vec::new();
     let mut rays = Vec::new();
+    let most = threads.iter().copied().max().unwrap_or(1);
+    let mut control = control::Control::new(most)?;
     for scene in &scenes {
         let json = if bullet {
             Some(bullet_peer::export_to(scene, &args.out.join("scenes"))?)
@@ -212,6 +215,10 @@ pub fn run(args: &Args) -> Result<(), String> {
                     mt.extend(r.ray_ms_mt);
                     records.push(r.record);
                 }
+                if let Some(c) = &mut control {
+                    bar.set_message(format!("{} / control", scene.name));
+                    c.sample();
+                }
             }
             for runs in &runs {
                 let s = stats::summarize(runs);
@@ -242,7 +249,16 @@ pub fn run(args: &Args) -> Result<(), String> {
         println!("Ray batch of the raytests scene (500 rays, closest hit):\n");
         println!("{}", report::ray_table(&rays));
     }
-    report::write_files(&args.out, "scenes", &summaries, &rays)?;
+    if let Some(c) = &control {
+        println!(
+            "Speed-up on {} threads over one (median ms/step; the control is a compute-bound \
+             parallel loop timed between the runs, the ratio of its median times: what the \
+             machine allowed meanwhile):\n",
+            c.threads
+        );
+        println!("{}", report::speedup_table(&summaries, c));
+    }
+    report::write_files(&args.out, "scenes", &summaries, &rays, control.as_ref())?;
     let png = args.out.join("scenes.png");
     chart::draw(&summaries, &png)?;
     println!(

@@ -1,6 +1,7 @@
 //! Output of `carom-bench scenes`: the Markdown table on stdout (with each engine's ratio to
 //! Rapier and to Bullet in the same configuration), the ray table, and the JSON and CSV files.
 
+use super::control::Control;
 use super::stats::Summary;
 use serde::Serialize;
 use std::fmt::Write as _;
@@ -103,6 +104,41 @@ pub fn ray_table(rows: &[RayRow]) -> String {
     out
 }
 
+/// The Markdown table of speed-ups: per scene and sleeping setting, each engine's median
+/// ms/step on one thread over its median on `control.threads` threads, and the control's
+/// speed-up over the whole run (of the median times) in every row.
+pub fn speedup_table(all: &[Summary], control: &Control) -> String {
+    let c = control.speedup().map_or("–".into(), |m| format!("{m:.2}x"));
+    let mut out = format!(
+        "| scene | sleep | engine | 1 thread | {0} threads | speed-up | control |\n|---|---|---|---|---|---|---|\n",
+        control.threads
+    );
+    for one in all
+        .iter()
+        .filter(|s| s.threads == 1 && s.engine != "bullet")
+    {
+        let Some(many) = all.iter().find(|o| {
+            o.engine == one.engine
+                && o.scene == one.scene
+                && o.sleeping == one.sleeping
+                && o.threads == control.threads
+        }) else {
+            continue;
+        };
+        let _ = writeln!(
+            out,
+            "| {} | {} | {} | {:.2} | {:.2} | {:.2}x | {c} |",
+            one.scene,
+            if one.sleeping { "on" } else { "off" },
+            one.engine,
+            one.ms_median,
+            many.ms_median,
+            one.ms_median / many.ms_median,
+        );
+    }
+    out
+}
+
 fn csv_field(x: Option<f64>) -> String {
     x.map_or(String::new(), |v| format!("{v:.6}"))
 }
@@ -148,10 +184,17 @@ pub fn csv(all: &[Summary]) -> String {
     out
 }
 
-/// Writes `<stem>.json` (summaries and ray rows) and `<stem>.csv` into `dir`.
-pub fn write_files(dir: &Path, stem: &str, all: &[Summary], rays: &[RayRow]) -> Result<(), String> {
+/// Writes `<stem>.json` (summaries, ray rows and the two-thread control's ratios) and
+/// `<stem>.csv` into `dir`.
+pub fn write_files(
+    dir: &Path,
+    stem: &str,
+    all: &[Summary],
+    rays: &[RayRow],
+    control: Option<&Control>,
+) -> Result<(), String> {
     std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
-    let json = serde_json::json!({ "summaries": all, "rays": rays });
+    let json = serde_json::json!({ "summaries": all, "rays": rays, "control": control });
     let text = serde_json::to_string_pretty(&json).map_err(|e| e.to_string())?;
     let write = |name: String, text: &str| {
         let path = dir.join(name);
