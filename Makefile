@@ -50,8 +50,9 @@ lint: toolchain
 	$(CARGO) clippy --workspace --all-targets -- -D warnings
 	# In the f64 build `x as Real` casts are no-ops by design.
 	$(CARGO) clippy --workspace --all-targets --features carom-collision/f64 -- -D warnings -A clippy::unnecessary_cast
-	# The serial build (no `parallel` feature) has cfg paths of its own.
-	$(CARGO) clippy -p carom-collision -p carom-dynamics --no-default-features --lib --tests -- -D warnings
+	# The serial build (no `parallel` feature) has cfg paths of its own (library code; its
+	# unit tests run in rust-test-serial).
+	$(CARGO) clippy -p carom-collision -p carom-dynamics --no-default-features --lib -- -D warnings
 
 rust-test: toolchain
 	$(CARGO) test --workspace
@@ -59,9 +60,10 @@ rust-test: toolchain
 rust-test-f64: toolchain
 	$(CARGO) test --workspace --features carom-collision/f64
 
-# The serial build: the tests of the two crates whose code switches on `parallel`.
+# The serial build: the unit tests of the two crates whose code switches on `parallel` (the
+# integration tests as well took CI from about 17 to 22 minutes of its 25; they passed).
 rust-test-serial: toolchain
-	$(CARGO) test -p carom-collision -p carom-dynamics --no-default-features
+	$(CARGO) test -p carom-collision -p carom-dynamics --no-default-features --lib
 
 # The long stacking tests in a release build, where they run up to 10x the steps of the debug
 # build (`common::steps`): a creep that only showed after 400 steps went unseen (session 10).
