@@ -2,8 +2,8 @@
 //! jitter inside and out of their fat boxes (refits, queries, candidate merges, pair diffs)
 //! reuse the buffers grown during a warm-up. The hashed grid, the hierarchical grid and the
 //! sort-and-sweep (rebuilt from scratch at every update) and the incremental sweep-and-prune
-//! reuse theirs too. (The two trees with Manhattan insertion allocate a few times in 48
-//! updates, varying from run to run; not covered here.)
+//! reuse theirs too. The two trees with Manhattan insertion (no rotations, deeper trees) take
+//! longer to reach their steady state: no allocation after the first 96 updates.
 
 use carom_collision::broadphase::{
     AnyBroadPhase, BroadPhase, Filter, Method, ProxyHandle, TreeBroadPhase,
@@ -140,4 +140,44 @@ fn steady_rebuilt_and_sweep_updates_allocate_nothing() {
         assert!(changes > 100, "{method:?}: pairs came and went: {changes}");
         assert_eq!(count, 0, "{method:?}: allocations in 48 steady updates");
     }
+}
+
+#[test]
+fn manhattan_trees_stop_allocating_after_a_longer_warm_up() {
+    // Bullet's Manhattan descent does no rotations, so its trees are deeper and keep
+    // deepening for longer while the boxes jitter: the traversal buffers grow in the first
+    // two windows of 48 updates (364 and 9 allocations), then never again. One thread, as
+    // in the test above, so that every allocation is counted.
+    use carom_collision::bvh::InsertStrategy;
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .unwrap();
+    let mut bp = TreeBroadPhase::new(InsertStrategy::Manhattan, TreeBroadPhase::DEFAULT_MARGIN);
+    let handles: Vec<ProxyHandle> = (0..1000)
+        .map(|_| {
+            bp.create_proxy(Aabb::new(Vec3::ZERO, Vec3::ONE), Filter::default())
+                .unwrap()
+        })
+        .collect();
+    let (counts, changes) = pool.install(|| {
+        let (mut counts, mut changes) = (Vec::new(), 0);
+        for window in 0..5 {
+            COUNT.with(|n| n.set(0));
+            COUNTING.with(|c| c.set(true));
+            for step in window * 48..(window + 1) * 48 {
+                changes += frame(&mut bp, &handles, step);
+            }
+            COUNTING.with(|c| c.set(false));
+            counts.push(COUNT.with(|n| n.get()));
+        }
+        (counts, changes)
+    });
+    assert!(changes > 100, "pairs came and went: {changes}");
+    assert!(counts[0] > 0, "the warm-up grows the buffers: {counts:?}");
+    assert_eq!(
+        counts[2..],
+        [0, 0, 0],
+        "allocations per window of 48 updates: {counts:?}"
+    );
 }
