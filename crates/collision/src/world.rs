@@ -153,6 +153,24 @@ fn finite_sum(sum: Real) -> bool {
     sum * 0.0 == 0.0
 }
 
+/// A process-wide unique number naming the objects of a [`CollisionWorld`] with their
+/// shapes and filters (see [`CollisionWorld::objects_stamp`]).
+#[derive(Debug, Clone, Copy)]
+struct ObjectsStamp(u64);
+
+impl ObjectsStamp {
+    /// A number no world has had in this process.
+    fn fresh() -> ObjectsStamp {
+        ObjectsStamp(crate::math::unique_stamp())
+    }
+}
+
+impl Default for ObjectsStamp {
+    fn default() -> Self {
+        ObjectsStamp::fresh()
+    }
+}
+
 /// Objects plus a broadphase (see the module docs).
 #[derive(Debug, Clone, Default)]
 pub struct CollisionWorld {
@@ -165,6 +183,8 @@ pub struct CollisionWorld {
     /// Number of objects that are not resting: when none is, no manifold can change and
     /// the narrowphase skips its shape tests (`NarrowPhase::step_with`).
     active: usize,
+    /// Changes whenever an object is added or removed or its filter changes.
+    stamp: ObjectsStamp,
 }
 
 impl CollisionWorld {
@@ -174,6 +194,16 @@ impl CollisionWorld {
             broadphase: AnyBroadPhase::new(method),
             ..Default::default()
         }
+    }
+
+    /// A number that names the world's objects with their shapes and filters: it is unique
+    /// in the process, given when the world is made and again whenever an object is added
+    /// or removed or its filter changes (an object's shape never changes), and kept by a
+    /// clone. Two calls that return the same number saw the same objects, shapes and
+    /// filters (poses, motions and resting hints may differ), so a cache of per-object data
+    /// keyed by it never serves stale data; `carom_dynamics`' query tree keeps one.
+    pub fn objects_stamp(&self) -> u64 {
+        self.stamp.0
     }
 
     /// The broadphase.
@@ -218,6 +248,7 @@ impl CollisionWorld {
             self.objects.resize(i + 1, None);
         }
         self.active += usize::from(!filter.is_static);
+        self.stamp = ObjectsStamp::fresh();
         self.objects[i] = Some(CollisionObject {
             shape,
             pose,
@@ -390,6 +421,7 @@ impl CollisionWorld {
         self.broadphase.set_filter(h.proxy(), filter)?;
         let o = self.objects[i].as_mut().expect("slot checked");
         o.filter = filter;
+        self.stamp = ObjectsStamp::fresh();
         let was = o.resting;
         o.resting |= filter.is_static;
         self.active -= usize::from(o.resting && !was);
@@ -416,6 +448,7 @@ impl CollisionWorld {
         self.narrowphase.clear_exclusions_of(h);
         let o = self.objects[i].take().expect("slot checked");
         self.active -= usize::from(!o.resting);
+        self.stamp = ObjectsStamp::fresh();
         Ok(o)
     }
 

@@ -113,6 +113,15 @@ pub fn outer(a: Vec3, b: Vec3) -> Mat3 {
     Mat3::from_cols(a * b.x, a * b.y, a * b.z)
 }
 
+/// A number no earlier call in this process returned (from 1 up): the identity stamps of
+/// meshes (`TriMesh`) and of collision worlds' object sets, which caches compare instead of
+/// the contents.
+pub(crate) fn unique_stamp() -> u64 {
+    use std::sync::atomic::{AtomicU64, Ordering};
+    static NEXT: AtomicU64 = AtomicU64::new(1);
+    NEXT.fetch_add(1, Ordering::Relaxed)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

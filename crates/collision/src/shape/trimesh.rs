@@ -62,9 +62,7 @@ pub(crate) struct MeshStamp(u64);
 impl MeshStamp {
     /// A number no other mesh has had in this process.
     fn fresh() -> MeshStamp {
-        use std::sync::atomic::{AtomicU64, Ordering};
-        static NEXT: AtomicU64 = AtomicU64::new(1);
-        MeshStamp(NEXT.fetch_add(1, Ordering::Relaxed))
+        MeshStamp(crate::math::unique_stamp())
     }
 }
 
