@@ -8,7 +8,7 @@
 
 use crate::broadphase::{AnyBroadPhase, BroadPhase, Filter, Method, ProxyHandle, UserFilter};
 use crate::error::{CaromError, Result};
-use crate::math::{check_isometry, Aabb, Isometry, Real, Vec3};
+use crate::math::{check_isometry, Aabb, Isometry, Real, Stamp, Vec3};
 use crate::narrowphase::{NarrowObject, NarrowPhase};
 use crate::shape::Shape;
 use std::sync::Arc;
@@ -153,24 +153,6 @@ fn finite_sum(sum: Real) -> bool {
     sum * 0.0 == 0.0
 }
 
-/// A process-wide unique number naming the objects of a [`CollisionWorld`] with their
-/// shapes and filters (see [`CollisionWorld::objects_stamp`]).
-#[derive(Debug, Clone, Copy)]
-struct ObjectsStamp(u64);
-
-impl ObjectsStamp {
-    /// A number no world has had in this process.
-    fn fresh() -> ObjectsStamp {
-        ObjectsStamp(crate::math::unique_stamp())
-    }
-}
-
-impl Default for ObjectsStamp {
-    fn default() -> Self {
-        ObjectsStamp::fresh()
-    }
-}
-
 /// Objects plus a broadphase (see the module docs).
 #[derive(Debug, Clone, Default)]
 pub struct CollisionWorld {
@@ -184,7 +166,7 @@ pub struct CollisionWorld {
     /// the narrowphase skips its shape tests (`NarrowPhase::step_with`).
     active: usize,
     /// Changes whenever an object is added or removed or its filter changes.
-    stamp: ObjectsStamp,
+    stamp: Stamp,
 }
 
 impl CollisionWorld {
@@ -203,7 +185,7 @@ impl CollisionWorld {
     /// filters (poses, motions and resting hints may differ), so a cache of per-object data
     /// keyed by it never serves stale data; `carom_dynamics`' query tree keeps one.
     pub fn objects_stamp(&self) -> u64 {
-        self.stamp.0
+        self.stamp.get()
     }
 
     /// The broadphase.
@@ -248,7 +230,7 @@ impl CollisionWorld {
             self.objects.resize(i + 1, None);
         }
         self.active += usize::from(!filter.is_static);
-        self.stamp = ObjectsStamp::fresh();
+        self.stamp = Stamp::fresh();
         self.objects[i] = Some(CollisionObject {
             shape,
             pose,
@@ -421,7 +403,7 @@ impl CollisionWorld {
         self.broadphase.set_filter(h.proxy(), filter)?;
         let o = self.objects[i].as_mut().expect("slot checked");
         o.filter = filter;
-        self.stamp = ObjectsStamp::fresh();
+        self.stamp = Stamp::fresh();
         let was = o.resting;
         o.resting |= filter.is_static;
         self.active -= usize::from(o.resting && !was);
@@ -448,7 +430,7 @@ impl CollisionWorld {
         self.narrowphase.clear_exclusions_of(h);
         let o = self.objects[i].take().expect("slot checked");
         self.active -= usize::from(!o.resting);
-        self.stamp = ObjectsStamp::fresh();
+        self.stamp = Stamp::fresh();
         Ok(o)
     }
 

@@ -113,13 +113,39 @@ pub fn outer(a: Vec3, b: Vec3) -> Mat3 {
     Mat3::from_cols(a * b.x, a * b.y, a * b.z)
 }
 
-/// A number no earlier call in this process returned (from 1 up): the identity stamps of
-/// meshes (`TriMesh`) and of collision worlds' object sets, which caches compare instead of
-/// the contents.
-pub(crate) fn unique_stamp() -> u64 {
-    use std::sync::atomic::{AtomicU64, Ordering};
-    static NEXT: AtomicU64 = AtomicU64::new(1);
-    NEXT.fetch_add(1, Ordering::Relaxed)
+/// A process-wide unique number naming some contents: a [`crate::shape::TriMesh`]'s
+/// triangles, a [`crate::world::CollisionWorld`]'s objects. Caches compare it instead of the
+/// contents, so their owners take a fresh one whenever the contents change; a clone keeps it
+/// (same contents). Equality of the owners ignores it (always equal): it names contents,
+/// it is not part of them.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Stamp(u64);
+
+impl Stamp {
+    /// A number no earlier stamp in this process had (from 1 up).
+    pub(crate) fn fresh() -> Stamp {
+        use std::sync::atomic::{AtomicU64, Ordering};
+        static NEXT: AtomicU64 = AtomicU64::new(1);
+        Stamp(NEXT.fetch_add(1, Ordering::Relaxed))
+    }
+
+    /// The number.
+    pub(crate) fn get(self) -> u64 {
+        self.0
+    }
+}
+
+impl Default for Stamp {
+    fn default() -> Self {
+        Stamp::fresh()
+    }
+}
+
+impl PartialEq for Stamp {
+    /// Always true (see the type's docs).
+    fn eq(&self, _: &Stamp) -> bool {
+        true
+    }
 }
 
 #[cfg(test)]

@@ -7,7 +7,7 @@ use super::trimesh_edges::{compute_edges, weld_vertices, MeshEdge, DEFAULT_FLAT_
 use super::MassProperties;
 use crate::bvh::{Bvh, BvhLayout};
 use crate::error::{CaromError, Result};
-use crate::math::{check_finite_vec, check_non_negative, Aabb, Real, Vec3};
+use crate::math::{check_finite_vec, check_non_negative, Aabb, Real, Stamp, Vec3};
 use serde::{Deserialize, Serialize};
 
 /// Options of [`TriMesh::with_options`].
@@ -47,36 +47,12 @@ pub struct TriMesh {
     edges: Vec<[MeshEdge; 3]>,
     flat_angle: Real,
     /// Identifies this mesh's current contents for caches of its queries (not serialised,
-    /// ignored by `==`).
+    /// ignored by `==`): fresh when the mesh is built, deserialised or changed
+    /// ([`TriMesh::set_vertices`]). The narrowphase's per-thread box-query cache
+    /// (`narrowphase::mesh`) keys its entries by it, so an entry can never serve another
+    /// mesh, or this mesh after its vertices moved.
     #[serde(skip)]
-    stamp: MeshStamp,
-}
-
-/// A process-wide unique number given to a [`TriMesh`] when it is built, deserialised or
-/// changed ([`TriMesh::set_vertices`]); a clone keeps it (same contents). The narrowphase's
-/// per-thread box-query cache (`narrowphase::mesh`) keys its entries by it, so an entry can
-/// never serve another mesh, or this mesh after its vertices moved. Equality ignores it.
-#[derive(Debug, Clone, Copy)]
-pub(crate) struct MeshStamp(u64);
-
-impl MeshStamp {
-    /// A number no other mesh has had in this process.
-    fn fresh() -> MeshStamp {
-        MeshStamp(crate::math::unique_stamp())
-    }
-}
-
-impl Default for MeshStamp {
-    fn default() -> Self {
-        MeshStamp::fresh()
-    }
-}
-
-impl PartialEq for MeshStamp {
-    /// Always true: two meshes are equal by their contents.
-    fn eq(&self, _: &MeshStamp) -> bool {
-        true
-    }
+    stamp: Stamp,
 }
 
 /// The serialised form of a [`TriMesh`], checked on load by `TryFrom`: the vertices and
@@ -136,7 +112,7 @@ fn check_data(d: TriMeshData) -> Result<TriMesh> {
             bvh: d.bvh,
             edges: d.edges,
             flat_angle: d.flat_angle,
-            stamp: MeshStamp::fresh(),
+            stamp: Stamp::fresh(),
         })
     }
 }
@@ -204,7 +180,7 @@ impl TriMesh {
             bvh,
             edges,
             flat_angle: options.flat_angle,
-            stamp: MeshStamp::fresh(),
+            stamp: Stamp::fresh(),
         })
     }
 
@@ -223,14 +199,14 @@ impl TriMesh {
         self.edges = compute_edges(&vertices, &self.indices, self.flat_angle);
         self.local_aabb = self.bvh.root_aabb();
         self.vertices = vertices;
-        self.stamp = MeshStamp::fresh();
+        self.stamp = Stamp::fresh();
         Ok(())
     }
 
-    /// The number identifying this mesh's current contents (see [`MeshStamp`]).
+    /// The number identifying this mesh's current contents (see the `stamp` field).
     #[inline]
     pub(crate) fn stamp(&self) -> u64 {
-        self.stamp.0
+        self.stamp.get()
     }
 
     /// The vertices.
