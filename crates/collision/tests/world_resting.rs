@@ -1,7 +1,9 @@
 //! A world whose objects all rest (or are static) skips the narrowphase's shape tests and
 //! the broadphase's pass over its candidates: the pairs, manifolds and events must be those
 //! of the same world with one far, unrelated object still active (which takes the full
-//! path), including an exclusion set while everything rests.
+//! path), including an exclusion set and lifted while everything rests. Quiet updates in a
+//! row hand back the last events without rebuilding them (the narrowphase's settled state),
+//! so rounds 1, 3 and 5 check that path and rounds 2 and 4 that an exclusion leaves it.
 
 use carom_collision::broadphase::{Filter, Method};
 use carom_collision::math::{Isometry, Real, Vec3};
@@ -78,11 +80,12 @@ fn a_resting_world_keeps_its_pairs_manifolds_and_events() {
             w.set_resting(o[1], true).unwrap();
             w.set_resting(o[2], true).unwrap();
         }
-        for round in 0..4 {
-            if round == 2 {
+        for round in 0..6 {
+            if round == 2 || round == 4 {
                 // Excluded while everything rests: emptied, and an End at the next update.
+                // Lifted while everything rests: nothing is generated until a box moves.
                 for (w, o) in &mut worlds {
-                    w.set_pair_excluded(o[1], o[2], true).unwrap();
+                    w.set_pair_excluded(o[1], o[2], round == 2).unwrap();
                 }
             }
             for (w, _) in &mut worlds {
