@@ -139,6 +139,21 @@ pub(crate) fn idle(set: &BodySet) -> bool {
     })
 }
 
+/// True when every live body is static or a sleeping dynamic body: [`idle`] without a
+/// kinematic body. A step then changes no body at all (a parked kinematic body is still
+/// integrated, its rotation renormalised), so with no contact handed on it skips the solver
+/// (`DynamicsWorld::finish_step`).
+pub(crate) fn frozen(set: &BodySet) -> bool {
+    (0..set.capacity()).all(|i| {
+        !set.is_alive(i)
+            || match set.info[i].body_type {
+                BodyType::Dynamic => set.info[i].sleeping,
+                BodyType::Kinematic => false,
+                BodyType::Static => true,
+            }
+    })
+}
+
 /// Computes the island root of every body slot into `scratch.roots`, joining bodies through
 /// the manifolds with points, the `resting` pairs and the unbroken joints.
 #[inline(never)] // its own entry in profiles

@@ -56,6 +56,8 @@ impl Default for WorldParams {
 pub(crate) struct BegunStep {
     start: Instant,
     islands: bool,
+    /// Every live body static or asleep ([`island::frozen`]).
+    frozen: bool,
     report: StepReport,
 }
 
@@ -274,8 +276,10 @@ impl DynamicsWorld {
             }
         }
         let mut report = StepReport::default();
-        let islands =
-            island::needed(&self.bodies, &self.params.sleep, dt) && !island::idle(&self.bodies);
+        let frozen = island::frozen(&self.bodies);
+        let islands = island::needed(&self.bodies, &self.params.sleep, dt)
+            && !frozen
+            && !island::idle(&self.bodies);
         if islands {
             let touching = (contacts, resting);
             island::build(&self.bodies, touching, &self.joints, &mut self.islands);
@@ -287,6 +291,7 @@ impl DynamicsWorld {
         Ok(BegunStep {
             start,
             islands,
+            frozen,
             report,
         })
     }
@@ -320,11 +325,50 @@ impl DynamicsWorld {
         let BegunStep {
             start,
             islands,
+            frozen,
             mut report,
         } = begun;
         if let Some(checked) = regathered {
             self.check_contacts(contacts, checked)?;
         }
+        // Nothing can move when every body is static or asleep (a force on a sleeping
+        // body would have woken it) and no contact is handed on: the solver skips the
+        // joints of sleeping bodies and would only clear the forces, and no timer
+        // advances. So such a step skips the solver and the sleep update ("1000 stack"
+        // asleep: 0.055 -> 0.021 ms a step with the narrowphase's settled events).
+        let still = frozen && contacts.is_empty() && report.woken.is_empty();
+        if still {
+            integrate::clear_forces(&mut self.bodies, usize::MAX);
+        } else {
+            self.solve(dt, contacts, &mut report);
+        }
+
+        let t = Instant::now();
+        for (jh, j) in self.joints.iter_mut() {
+            // The peak of the step's impulse, summed over its substeps (`joints::store`;
+            // a joint the solver skipped keeps the peak it had).
+            if !j.broken && j.step_peak > j.desc.break_impulse {
+                j.broken = true;
+                report.broken_joints.push(jh);
+            }
+        }
+        if !still {
+            report.slept = island::update_sleep(
+                &mut self.bodies,
+                &mut self.islands,
+                dt,
+                &self.params.sleep,
+                islands,
+            );
+        }
+        report.timings.store += t.elapsed();
+        report.timings.total = start.elapsed();
+        Ok(report)
+    }
+
+    /// Integration and the constraint solver over the awake bodies (the solvers store the
+    /// velocities and world inertias and clear the forces).
+    fn solve(&mut self, dt: Real, contacts: &mut [ContactManifold], report: &mut StepReport) {
         integrate::load(&self.bodies, &mut self.solver_bodies);
         let mut ctx = StepContext {
             set: &mut self.bodies,
@@ -344,26 +388,6 @@ impl DynamicsWorld {
             SolverKind::SequentialImpulse => solver::sequential::step(&mut ctx),
             SolverKind::SoftStep => solver::soft_step::step(&mut ctx),
         }
-
-        let t = Instant::now();
-        // (The solvers stored the velocities and world inertias and cleared the forces.)
-        for (jh, j) in self.joints.iter_mut() {
-            // The peak of the step's impulse, summed over its substeps (`joints::store`).
-            if !j.broken && j.step_peak > j.desc.break_impulse {
-                j.broken = true;
-                report.broken_joints.push(jh);
-            }
-        }
-        report.slept = island::update_sleep(
-            &mut self.bodies,
-            &mut self.islands,
-            dt,
-            &self.params.sleep,
-            islands,
-        );
-        report.timings.store += t.elapsed();
-        report.timings.total = start.elapsed();
-        Ok(report)
     }
 
     /// A hash of every body's position, rotation and velocities (bit patterns), for

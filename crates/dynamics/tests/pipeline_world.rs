@@ -242,3 +242,61 @@ fn a_sleeping_stack_wakes_whole_with_its_contacts_in_the_same_step() {
     assert_eq!(one.contact_points, every.contact_points);
     assert!(one.manifolds >= 4);
 }
+
+/// Steps of a world whose bodies all sleep change nothing (they skip the solver, and the
+/// narrowphase hands back its settled events): the state hash and the events stay as they
+/// were, nothing wakes or sleeps, and a copy taken before those steps, poked the same way
+/// afterwards, moves exactly (bit for bit) as the world that took them. A static body and
+/// a joint between two sleeping boxes are part of the world; a kinematic body, even parked,
+/// takes the full step (its rotation is renormalised), with the same outcome.
+#[test]
+fn steps_of_a_world_asleep_change_nothing() {
+    for kinematic in [false, true] {
+        let mut w = world(true);
+        ground(&mut w, 0.5);
+        let boxes = box_column(&mut w, 4);
+        let up = |y: Real| Isometry::from_translation(Vec3::new(0.0, y, 0.0));
+        let mut joint = JointDesc::new(boxes[2], boxes[3], up(0.5), up(-0.5), JointKind::Fixed);
+        joint.disable_collisions = false;
+        w.create_joint(&joint).unwrap();
+        if kinematic {
+            let far = Isometry::from_translation(Vec3::new(9.0, 5.0, 0.0));
+            let mut k = BodyDesc::dynamic(sphere(0.3), far, 1.0);
+            k.body_type = BodyType::Kinematic;
+            w.add_body(&k).unwrap();
+        }
+        for _ in 0..240 {
+            w.step(1.0 / 60.0).unwrap();
+        }
+        assert_eq!(w.sleeping_count(), 4);
+        let before = w.clone();
+        let (hash, events) = (
+            w.state_hash(),
+            w.collision().narrowphase().events().to_vec(),
+        );
+        assert!(events.len() >= 4);
+        for _ in 0..30 {
+            let r = w.step(1.0 / 60.0).unwrap();
+            assert_eq!((r.manifolds, r.dynamics.woken.len()), (0, 0));
+            assert!(r.dynamics.slept.is_empty() && r.dynamics.broken_joints.is_empty());
+            assert_eq!(w.state_hash(), hash);
+            assert_eq!(w.collision().narrowphase().events(), &events[..]);
+        }
+        let mut copies = [w, before];
+        for c in &mut copies {
+            let p = pos(c, boxes[3]);
+            c.bodies_mut()
+                .apply_impulse(boxes[3], Vec3::new(0.5, 0.0, 0.2), p)
+                .unwrap();
+            for _ in 0..60 {
+                c.step(1.0 / 60.0).unwrap();
+            }
+        }
+        assert_ne!(copies[0].state_hash(), hash, "the poke moved nothing");
+        assert_eq!(
+            copies[0].state_hash(),
+            copies[1].state_hash(),
+            "kinematic {kinematic}"
+        );
+    }
+}

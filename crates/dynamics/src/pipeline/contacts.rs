@@ -62,6 +62,11 @@ impl World {
     /// Stores the solver's impulses into the narrowphase points the contacts came from.
     #[inline(never)] // its own entry in profiles
     pub(super) fn write_back(&mut self) {
+        if self.contacts.is_empty() {
+            // Nothing to store; not borrowing the pairs mutably keeps a settled
+            // narrowphase settled (an idle world's quiet steps).
+            return;
+        }
         let (contacts, sources) = (&self.contacts, &self.sources);
         let pairs = self.collision.narrowphase_mut().pair_slice_mut();
         write_back_range(contacts, sources, pairs, 0, GATHER_CHUNK);
