@@ -174,14 +174,20 @@ impl World {
                 BodyType::Kinematic => true,
                 BodyType::Static => false,
             };
-            let pose = set.pose_of(i);
             // The resting hint first: the two-tree broadphase migrates the leaf with its
             // current fat box, and the box update below then refits it in its new tree.
             let resting = !moving;
-            if resting != self.resting[i] {
+            let was_resting = self.resting[i];
+            if resting != was_resting {
                 self.collision.set_resting(obj, resting)?;
                 self.resting[i] = resting;
+            } else if was_resting && info.body_type == BodyType::Dynamic {
+                // Asleep since the last sync, which zeroed its motion; its pose cannot have
+                // changed since (`set_pose` wakes a body). (A world asleep: 1077 bodies of
+                // "1000 stack" in 0.003 ms instead of 0.009.)
+                continue;
             }
+            let pose = set.pose_of(i);
             if moving {
                 // The rotation's sweep goes into the margin, the linear displacement into
                 // the motion: a pair's speculative distance counts the two bodies' relative
