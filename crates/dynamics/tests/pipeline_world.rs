@@ -145,6 +145,10 @@ fn resting_bodies_sleep_in_the_broadphase_and_wake_on_hit() {
     for &b in &boxes {
         let o = w.object(b).unwrap().unwrap();
         assert!(w.collision().get(o).unwrap().resting, "{b:?} not resting");
+        // The object has the pose the body fell asleep at (not the one synced before the
+        // step that integrated it last).
+        let pose = w.bodies().pose(b).unwrap();
+        assert_eq!(w.collision().get(o).unwrap().pose, pose, "{b:?}");
     }
     let before: Vec<Vec3> = boxes.iter().map(|&b| pos(&w, b)).collect();
     w.step(1.0 / 60.0).unwrap();

@@ -206,8 +206,12 @@ impl World {
             } else {
                 let o = self.collision.get(obj)?;
                 let (teleported, has_motion) = (o.pose != pose, o.motion != Vec3::ZERO);
-                if info.body_type == BodyType::Static && teleported {
-                    // A static body teleported through `bodies_mut().set_pose`.
+                if teleported {
+                    // A static body teleported through `bodies_mut().set_pose`, or a body
+                    // that fell asleep in the last step: the object still has the pose of
+                    // the sync before that step's integration (within v·dt of the body's,
+                    // below the sleep thresholds), and keeps the body's final one while it
+                    // sleeps.
                     self.collision.set_pose(obj, pose)?;
                 }
                 // Asleep or static: no motion (what a restored snapshot starts from too).
