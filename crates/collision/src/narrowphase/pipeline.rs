@@ -623,57 +623,5 @@ fn event_kind(was: bool, now: bool) -> Option<ContactEventKind> {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::math::Vec3;
-    use crate::shape::Sphere;
-    use ContactEventKind::{End, Persist};
-
-    /// The settled state: taken after a quiet step that reported only `Persist`, kept by the
-    /// next quiet step (which hands back the same events), left by a change of the pairs
-    /// through a `&mut` call, an added pair or an active object.
-    #[test]
-    fn quiet_steps_settle_and_any_change_unsettles() {
-        let ball = Shape::Sphere(Sphere::new(0.5).unwrap());
-        let at = |x: Real| Isometry::from_translation(Vec3::new(x, 0.0, 0.0));
-        let poses = [at(0.0), at(0.99), at(1.98)];
-        let lookup = |active: bool| {
-            let ball = &ball;
-            move |h: u32| {
-                Some(NarrowObject {
-                    active,
-                    ..NarrowObject::new(ball, poses[h as usize])
-                })
-            }
-        };
-        let mut np = NarrowPhase::<u32>::default();
-        let kinds = |np: &NarrowPhase<u32>| np.events().iter().map(|e| e.kind).collect::<Vec<_>>();
-        np.step(&[(0, 1), (1, 2)], &[], lookup(true)).unwrap();
-        assert!(!np.settled, "Begin events");
-        np.step_with(&[], &[], lookup(false), false).unwrap();
-        assert!(np.settled);
-        assert_eq!(kinds(&np), [Persist, Persist]);
-        np.step_with(&[], &[], lookup(false), false).unwrap();
-        assert!(np.settled);
-        assert_eq!(kinds(&np), [Persist, Persist]);
-        np.set_excluded(1, 2, true);
-        assert!(!np.settled);
-        np.step_with(&[], &[], lookup(false), false).unwrap();
-        assert_eq!(kinds(&np), [Persist, End]);
-        assert!(!np.settled, "an End event");
-        np.step_with(&[], &[], lookup(false), false).unwrap();
-        assert!(np.settled);
-        assert_eq!(kinds(&np), [Persist]);
-        let _ = np.pair_slice_mut();
-        assert!(!np.settled);
-        np.step_with(&[], &[], lookup(false), false).unwrap();
-        assert!(np.settled);
-        np.step_with(&[(0, 2)], &[], lookup(false), false).unwrap();
-        assert!(!np.settled, "a pair added");
-        np.step_with(&[], &[], lookup(false), false).unwrap();
-        assert!(np.settled);
-        np.step(&[], &[], lookup(true)).unwrap();
-        assert!(!np.settled, "an active object");
-        assert_eq!(kinds(&np), [Persist]);
-    }
-}
+#[path = "pipeline_tests.rs"]
+mod tests;
