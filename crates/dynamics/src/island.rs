@@ -123,35 +123,52 @@ fn touching<'a>(
         .chain(resting.iter().copied())
 }
 
-/// True when nothing can move or wake anything this step: every live dynamic body sleeps
-/// and no kinematic body moves (a body woken by a user call is awake). Islands would then
-/// wake nothing, and no manifold would reach the solver, so the step skips both.
-pub(crate) fn idle(set: &BodySet) -> bool {
-    (0..set.capacity()).all(|i| {
-        !set.is_alive(i)
-            || match set.info[i].body_type {
-                BodyType::Dynamic => set.info[i].sleeping,
-                BodyType::Kinematic => {
-                    set.linear_velocity[i] == Vec3::ZERO && set.angular_velocity[i] == Vec3::ZERO
-                }
-                BodyType::Static => true,
-            }
-    })
+/// What can move in a step, from one pass over the bodies.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Stillness {
+    /// An awake dynamic body or a moving kinematic one.
+    Moving,
+    /// Nothing can move or wake anything: every live dynamic body sleeps and no kinematic
+    /// body moves (a body woken by a user call is awake). Islands would then wake nothing,
+    /// and no manifold would reach the solver, so the step skips both.
+    Idle,
+    /// [`Stillness::Idle`] without any kinematic body: every live body is static or a
+    /// sleeping dynamic body. A step then changes no body at all (a parked kinematic body
+    /// is still integrated, its rotation renormalised), so with no contact handed on it
+    /// also skips the solver (`DynamicsWorld::finish_step`).
+    Frozen,
 }
 
-/// True when every live body is static or a sleeping dynamic body: [`idle`] without a
-/// kinematic body. A step then changes no body at all (a parked kinematic body is still
-/// integrated, its rotation renormalised), so with no contact handed on it skips the solver
-/// (`DynamicsWorld::finish_step`).
-pub(crate) fn frozen(set: &BodySet) -> bool {
-    (0..set.capacity()).all(|i| {
-        !set.is_alive(i)
-            || match set.info[i].body_type {
-                BodyType::Dynamic => set.info[i].sleeping,
-                BodyType::Kinematic => false,
-                BodyType::Static => true,
+impl Stillness {
+    /// Idle or frozen.
+    pub(crate) fn idle(self) -> bool {
+        self != Stillness::Moving
+    }
+}
+
+/// The [`Stillness`] of `set`: stops at the first body that moves.
+pub(crate) fn stillness(set: &BodySet) -> Stillness {
+    let mut kinematic = false;
+    for i in 0..set.capacity() {
+        if !set.is_alive(i) {
+            continue;
+        }
+        match set.info[i].body_type {
+            BodyType::Dynamic if !set.info[i].sleeping => return Stillness::Moving,
+            BodyType::Kinematic => {
+                if set.linear_velocity[i] != Vec3::ZERO || set.angular_velocity[i] != Vec3::ZERO {
+                    return Stillness::Moving;
+                }
+                kinematic = true;
             }
-    })
+            _ => {}
+        }
+    }
+    if kinematic {
+        Stillness::Idle
+    } else {
+        Stillness::Frozen
+    }
 }
 
 /// Computes the island root of every body slot into `scratch.roots`, joining bodies through
@@ -326,6 +343,40 @@ mod tests {
 
     fn cuboid(h: Vec3) -> Arc<Shape> {
         Arc::new(Cuboid::new(h).unwrap().into())
+    }
+
+    /// `stillness` against the definitions: static only, a sleeping dynamic body, a
+    /// parked kinematic one, a kinematic one moving, an awake dynamic one, a dead slot.
+    #[test]
+    fn stillness_is_moving_idle_or_frozen() {
+        use super::{stillness, Stillness};
+        use crate::BodySet;
+        let mut set = BodySet::new();
+        let shape = cuboid(Vec3::splat(0.5));
+        set.insert(&BodyDesc::fixed(shape.clone(), Isometry::IDENTITY))
+            .unwrap();
+        assert_eq!(stillness(&set), Stillness::Frozen);
+        let box_ = BodyDesc::dynamic(shape.clone(), Isometry::IDENTITY, 1.0);
+        let d = set.insert(&box_).unwrap();
+        assert_eq!(stillness(&set), Stillness::Moving);
+        let slot = set.slot(d).unwrap();
+        set.info[slot].sleeping = true;
+        assert_eq!(stillness(&set), Stillness::Frozen);
+        let mut kin = box_.clone();
+        kin.body_type = BodyType::Kinematic;
+        let k = set.insert(&kin).unwrap();
+        assert_eq!(stillness(&set), Stillness::Idle);
+        assert!(Stillness::Idle.idle() && Stillness::Frozen.idle() && !Stillness::Moving.idle());
+        set.set_angular_velocity(k, Vec3::Y).unwrap();
+        assert_eq!(stillness(&set), Stillness::Moving);
+        set.remove(k).unwrap();
+        assert_eq!(
+            stillness(&set),
+            Stillness::Frozen,
+            "a dead slot counts for nothing"
+        );
+        set.wake(d).unwrap();
+        assert_eq!(stillness(&set), Stillness::Moving);
     }
 
     /// Per step: the state hash and the bodies woken and put to sleep.

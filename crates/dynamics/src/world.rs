@@ -56,7 +56,7 @@ impl Default for WorldParams {
 pub(crate) struct BegunStep {
     start: Instant,
     islands: bool,
-    /// Every live body static or asleep ([`island::frozen`]).
+    /// Every live body static or asleep ([`island::Stillness::Frozen`]).
     frozen: bool,
     report: StepReport,
 }
@@ -248,7 +248,8 @@ impl DynamicsWorld {
         contacts: &mut [ContactManifold],
         checked: bool,
     ) -> Result<StepReport> {
-        let begun = self.begin_step(dt, contacts, checked, &[])?;
+        let stillness = island::stillness(&self.bodies);
+        let begun = self.begin_step(dt, contacts, checked, &[], stillness)?;
         self.finish_step(dt, contacts, begun, None)
     }
 
@@ -257,13 +258,15 @@ impl DynamicsWorld {
     /// touching without a manifold handed on) and the joints, and wakes the sleeping islands
     /// that hold an awake body. [`DynamicsWorld::finish_step`] solves with the contacts; the
     /// pipeline gathers them again between the two when this woke a body, since it hands
-    /// only the manifolds of awake bodies to the solver.
+    /// only the manifolds of awake bodies to the solver. `stillness` is the bodies'
+    /// [`island::stillness`] as the step begins (the pipeline has it from its gather).
     pub(crate) fn begin_step(
         &mut self,
         dt: Real,
         contacts: &[ContactManifold],
         checked: bool,
         resting: &[(usize, usize)],
+        stillness: island::Stillness,
     ) -> Result<BegunStep> {
         let start = Instant::now();
         if !(dt.is_finite() && dt > 0.0) {
@@ -276,10 +279,8 @@ impl DynamicsWorld {
             }
         }
         let mut report = StepReport::default();
-        let frozen = island::frozen(&self.bodies);
-        let islands = island::needed(&self.bodies, &self.params.sleep, dt)
-            && !frozen
-            && !island::idle(&self.bodies);
+        let frozen = stillness == island::Stillness::Frozen;
+        let islands = !stillness.idle() && island::needed(&self.bodies, &self.params.sleep, dt);
         if islands {
             let touching = (contacts, resting);
             island::build(&self.bodies, touching, &self.joints, &mut self.islands);

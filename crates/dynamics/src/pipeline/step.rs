@@ -63,10 +63,11 @@ impl World {
         // touching pairs of sleeping ones, and when they wake bodies, the manifolds are
         // gathered again before the solver runs. A world whose dynamic bodies all sleep (no
         // kinematic body moving) hands nothing on and wakes nothing: no gather, no islands
-        // (`island::idle`).
+        // (`island::Stillness::Idle`).
         let t = Instant::now();
         let bodies = self.dynamics.bodies();
-        let checked = if crate::island::idle(bodies) {
+        let stillness = crate::island::stillness(bodies);
+        let checked = if stillness.idle() {
             self.contacts.clear();
             self.sources.clear();
             self.resting_pairs.clear();
@@ -76,9 +77,13 @@ impl World {
             self.gather(islands)
         };
         let mut gather = t.elapsed();
-        let begun = self
-            .dynamics
-            .begin_step(dt, &self.contacts, checked, &self.resting_pairs)?;
+        let begun = self.dynamics.begin_step(
+            dt,
+            &self.contacts,
+            checked,
+            &self.resting_pairs,
+            stillness,
+        )?;
         let regathered = (!begun.woken().is_empty()).then(|| {
             let t = Instant::now();
             let checked = self.gather(false);
