@@ -22,7 +22,7 @@
 //! (It rebuilt after every eight refits before: in "raytests" the rebuilds were half the
 //! 500-ray batch's instructions.) Results do not depend on the topology (closest hit, ties
 //! to the lower body slot), so a refitted tree answers exactly what a fresh one would.
-//! The cache also keeps each body's query item (body, shape, filter, local box and ball
+//! The cache also keeps each body's query item (body, shape, filter groups, local box and ball
 //! radius) with the collision world's `objects_stamp`, which changes whenever an object is
 //! added or removed or its filter changes: while it holds, a query reads only the bodies'
 //! poses, not the collision objects, the object-to-body map and the shapes (the raytests
@@ -39,7 +39,6 @@
 
 use super::World;
 use crate::body_set::BodyHandle;
-use carom_collision::broadphase::Filter;
 use carom_collision::math::{check_finite_vec, check_isometry, Aabb, Isometry, Mat3, Real, Vec3};
 use carom_collision::midphase::{Bvh, BvhLayout};
 use carom_collision::query::{raycast_ray, shape_cast, Ray, RayHit, ShapeCastHit};
@@ -101,7 +100,8 @@ struct QueryObject {
 struct QueryItem {
     body: BodyHandle,
     shape: Arc<Shape>,
-    filter: Filter,
+    /// The collision object's filter groups (what a query's mask tests).
+    group: u32,
     /// The shape's local box: centre and half extents (unused for planes).
     local_center: Vec3,
     local_half: Vec3,
@@ -436,7 +436,7 @@ impl World {
                 pose,
                 center,
                 radius: item.radius,
-                group: item.filter.group,
+                group: item.group,
             });
         }
         if boxes.is_empty() {
@@ -473,7 +473,7 @@ impl World {
                 Some(QueryItem {
                     body,
                     shape: Arc::clone(&o.shape),
-                    filter: o.filter,
+                    group: o.filter.group,
                     local_center,
                     local_half,
                     radius,
