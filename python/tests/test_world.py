@@ -49,6 +49,15 @@ def test_box_comes_to_rest_on_the_ground() -> None:
     assert np.linalg.norm(lin) < 0.05
     stats = w.last_step()
     assert stats["pairs"] >= 1 and stats["total"] >= 0.0
+    # No query since the last step: the step kept no query tree current.
+    assert stats["query_tree"] == 0.0
+    # A ray cast, then a step: the step refreshes the tree the ray used.
+    hit = w.raycast([0.0, 3.0, 0.0], [0.0, -1.0, 0.0], 10.0)
+    assert hit is not None
+    w.step(1)
+    assert w.last_step()["query_tree"] > 0.0
+    again = w.raycast([0.0, 3.0, 0.0], [0.0, -1.0, 0.0], 10.0)
+    assert again is not None and again.distance == pytest.approx(hit.distance, abs=1e-3)
 
 
 def test_sliding_box_stops_where_coulomb_says() -> None:

@@ -261,6 +261,30 @@ fn queries_reject_bad_input_and_handle_an_empty_world() {
     assert!(e.contains("velocity"), "{e}");
 }
 
+/// `n` rays from the plane z = -12 across the scene (origins, directions).
+fn rays_across(rng: &mut Lcg, n: usize) -> (Vec<Vec3>, Vec<Vec3>) {
+    (0..n)
+        .map(|_| {
+            let o = Vec3::new(rng.range(-10.0, 10.0), rng.range(0.2, 8.0), -12.0);
+            (
+                o,
+                Vec3::new(rng.range(-0.3, 0.3), rng.range(-0.4, 0.1), 1.0),
+            )
+        })
+        .unzip()
+}
+
+/// The batch's answers from `w` (with its kept tree) and from a clone (which starts without
+/// one), up to 40 m.
+fn cached_and_fresh(
+    w: &World,
+    origins: &[Vec3],
+    dirs: &[Vec3],
+) -> (Vec<Option<BodyRayHit>>, Vec<Option<BodyRayHit>>) {
+    let cast = |w: &World| w.raycast_batch(origins, dirs, 40.0, u32::MAX).unwrap();
+    (cast(w), cast(&w.clone()))
+}
+
 #[test]
 fn cached_query_trees_answer_like_fresh_ones() {
     // The world keeps its query tree between calls: reused when no box changed, refitted
@@ -270,16 +294,7 @@ fn cached_query_trees_answer_like_fresh_ones() {
     // hits match the brute force.
     let mut rng = Lcg(3);
     let (mut w, mut hs) = scene(Vec3::ZERO, &mut rng);
-    let mut origins = Vec::new();
-    let mut dirs = Vec::new();
-    for _ in 0..200 {
-        origins.push(Vec3::new(
-            rng.range(-10.0, 10.0),
-            rng.range(0.2, 8.0),
-            -12.0,
-        ));
-        dirs.push(Vec3::new(rng.range(-0.3, 0.3), rng.range(-0.4, 0.1), 1.0));
-    }
+    let (origins, dirs) = rays_across(&mut rng, 200);
     let probe = sphere(0.3);
     let mut hits = 0;
     for step in 0..24 {
@@ -295,12 +310,8 @@ fn cached_query_trees_answer_like_fresh_ones() {
             );
             hs.push(w.add_body(&d).unwrap());
         }
-        let cached = w.raycast_batch(&origins, &dirs, 40.0, u32::MAX).unwrap();
+        let (cached, fresh) = cached_and_fresh(&w, &origins, &dirs);
         let again = w.raycast_batch(&origins, &dirs, 40.0, u32::MAX).unwrap();
-        let fresh = w
-            .clone()
-            .raycast_batch(&origins, &dirs, 40.0, u32::MAX)
-            .unwrap();
         assert_eq!(cached, fresh, "step {step}: cached and fresh trees differ");
         assert_eq!(again, cached, "step {step}: a reused tree differs");
         for (i, got) in cached.iter().enumerate() {
@@ -322,4 +333,73 @@ fn cached_query_trees_answer_like_fresh_ones() {
         w.step(1.0 / 60.0).unwrap();
     }
     assert!(hits > 24 * 10, "{hits} hits");
+}
+
+#[test]
+fn queries_after_steps_and_moves_answer_like_fresh_ones() {
+    // The step refreshes a query tree used since the last step, and a query then takes it
+    // as it is; a teleport (through the world or its body set), an added or a removed body,
+    // or a step taken without a query in between make the next query compute the tree
+    // again. Over 300 random operations, every query answers as a clone of the world (which
+    // starts without a cache) does, and the step reports the refresh's time only when a
+    // query used the tree since the step before.
+    let mut rng = Lcg(29);
+    let (mut w, mut hs) = scene(Vec3::ZERO, &mut rng);
+    let (origins, dirs) = rays_across(&mut rng, 60);
+    let (mut queried, mut refreshed, mut idle) = (false, 0, 0);
+    let mut ops = [0usize; 6];
+    for round in 0..300 {
+        let op = (rng.next() * 6.0) as usize;
+        ops[op] += 1;
+        let pick = |rng: &mut Lcg, hs: &[BodyHandle]| {
+            hs[1 + (rng.next() * (hs.len() - 1) as Real) as usize]
+        };
+        let far = Isometry::from_translation(Vec3::new(
+            rng.range(-8.0, 8.0),
+            rng.range(0.5, 5.0),
+            rng.range(-8.0, 8.0),
+        ));
+        match op {
+            0 | 1 => {
+                w.step(1.0 / 60.0).unwrap();
+                let t = w.last_report().timings.query_tree;
+                if queried {
+                    refreshed += 1;
+                } else {
+                    idle += 1;
+                    assert_eq!(t, std::time::Duration::ZERO, "round {round}");
+                }
+                queried = false;
+            }
+            2 => {
+                let h = pick(&mut rng, &hs);
+                w.set_pose(h, far).unwrap();
+            }
+            3 => {
+                let h = pick(&mut rng, &hs);
+                w.bodies_mut().set_pose(h, far).unwrap();
+            }
+            4 if hs.len() > 20 => {
+                let h = pick(&mut rng, &hs);
+                w.remove_body(h).unwrap();
+                hs.retain(|&x| x != h);
+            }
+            _ => {
+                hs.push(
+                    w.add_body(&BodyDesc::dynamic(sphere(0.4), far, 500.0))
+                        .unwrap(),
+                );
+            }
+        }
+        if rng.next() < 0.6 {
+            let (cached, fresh) = cached_and_fresh(&w, &origins, &dirs);
+            assert_eq!(cached, fresh, "round {round} (operation {op})");
+            queried = true;
+        }
+    }
+    assert!(
+        refreshed > 40 && idle > 20,
+        "{refreshed} refreshed, {idle} idle steps"
+    );
+    assert!(ops.iter().all(|&n| n > 20), "{ops:?}");
 }

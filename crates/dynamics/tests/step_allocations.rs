@@ -234,11 +234,23 @@ fn a_settled_pile_steps_without_allocating() {
     pool.install(settled_pile_steps);
 }
 
+/// With `queried`, a ray is cast (outside the count) before every step, so that every step
+/// also refreshes the world's query tree (`pipeline::query_cache`).
 fn settled_pile_steps() {
-    for parallel in [false, true] {
+    for (parallel, queried) in [(false, false), (true, false), (false, true)] {
         let mut w = settled_pile(parallel);
+        let cast = |w: &World| {
+            if queried {
+                w.raycast(Vec3::new(0.0, 0.5, -5.0), Vec3::Z, 10.0, u32::MAX)
+                    .unwrap()
+                    .expect("the ray meets the pile");
+            }
+        };
+        cast(&w);
+        w.step(1.0 / 60.0).unwrap();
         let counts: Vec<usize> = (0..20)
             .map(|_| {
+                cast(&w);
                 count_allocations(|| {
                     w.step(1.0 / 60.0).unwrap();
                 })
@@ -246,9 +258,11 @@ fn settled_pile_steps() {
             .collect();
         let r = w.last_report();
         eprintln!(
-            "parallel {parallel}: {} pairs, {} manifolds, allocations {counts:?}",
+            "parallel {parallel}, queried {queried}: {} pairs, {} manifolds, allocations \
+             {counts:?}",
             r.pairs, r.manifolds
         );
+        assert_eq!(r.timings.query_tree.is_zero(), !queried);
         assert!(r.manifolds >= 12, "the pile touches: {}", r.manifolds);
         assert!(counts.iter().all(|&c| c == 0), "{counts:?}");
     }

@@ -402,7 +402,7 @@ impl PyWorld {
     }
 
     /// Per-stage wall times of the last step in milliseconds (`sync`, `broadphase`,
-    /// `narrowphase`, `contacts`, `solver`, `integrate`, `islands`, `total`), plus the
+    /// `narrowphase`, `contacts`, `solver`, `integrate`, `islands`, `query_tree`, `total`), plus the
     /// counts of `pairs`, `manifolds` and `points`.
     fn last_step<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let r = self.world.last_report();
@@ -416,6 +416,7 @@ impl PyWorld {
             ("solver", t.solver),
             ("integrate", t.integrate),
             ("islands", t.islands),
+            ("query_tree", t.query_tree),
             ("total", t.total),
         ] {
             d.set_item(k, v.as_secs_f64() * 1e3)?;

@@ -89,7 +89,8 @@ impl Engine for CaromEngine {
                 .expect("a valid scene steps without error")
         });
         StageTimes {
-            broadphase: Some(ms(t.sync) + ms(t.broadphase)),
+            // The query tree's refresh is the broadphase tree upkeep the peers' ray casts rely on.
+            broadphase: Some(ms(t.sync) + ms(t.broadphase) + ms(t.query_tree)),
             narrowphase: Some(ms(t.narrowphase) + ms(t.contacts)),
             solver: Some(ms(t.solver) + ms(t.islands)),
             integration: Some(ms(t.integrate)),

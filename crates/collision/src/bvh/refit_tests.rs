@@ -85,8 +85,13 @@ fn refit_in_place_is_a_fresh_fit() {
                 let mut bvh = Bvh::with_max_leaf_size(first, layout, leaf).unwrap();
                 for next in [second, first] {
                     let want = fresh_fit(&bvh, next);
+                    // `refit_with` and a buffer left dirty by another tree: the same tree.
+                    let mut other = bvh.clone();
+                    let mut scratch = vec![Aabb::new(Vec3::ZERO, Vec3::ONE); 7];
+                    other.refit_with(next, &mut scratch).unwrap();
                     bvh.refit(next).unwrap();
                     assert!(bvh == want, "{layout:?}, leaves of {leaf}");
+                    assert!(other == want && other.wide == want.wide, "refit_with");
                     assert!(bvh.wide == want.wide, "{layout:?}, leaves of {leaf}");
                     // A saved and loaded copy collapses afresh: equal as a hierarchy.
                     let bytes = postcard::to_allocvec(&bvh).unwrap();

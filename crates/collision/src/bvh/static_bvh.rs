@@ -337,6 +337,12 @@ impl Bvh {
     /// quantised layout collapses its 4-wide nodes again (the same as a fresh build's); the
     /// unquantised one keeps their topology and rewrites their boxes.
     pub fn refit(&mut self, boxes: &[Aabb]) -> Result<()> {
+        self.refit_with(boxes, &mut Vec::new())
+    }
+
+    /// [`Bvh::refit`] with a caller's buffer for the node boxes it fits: no allocation once
+    /// the buffer has held as many boxes as the tree has nodes (a tree refitted every step).
+    pub fn refit_with(&mut self, boxes: &[Aabb], scratch: &mut Vec<Aabb>) -> Result<()> {
         check_boxes(boxes)?;
         if boxes.len() != self.order.len() {
             return Err(CaromError::invalid(
@@ -352,12 +358,13 @@ impl Bvh {
         // dequantised), re-quantised into the same node array, and the 4-wide nodes are
         // collapsed again into their own buffer. The same nodes as `make_nodes` and
         // `wide_nodes` over fresh arrays (`refit_in_place_is_a_fresh_fit` compares them).
-        let aabbs = with_nodes!(self, ns => fit_node_boxes(&ns, &self.order, boxes));
+        with_nodes!(self, ns => fit_node_boxes(&ns, &self.order, boxes, scratch));
+        let aabbs = scratch.as_slice();
         self.bounds = aabbs[0];
         match &mut self.nodes {
             Nodes::Quantized(v, q) => {
                 *q = Quantization::new(&self.bounds);
-                for (n, a) in v.iter_mut().zip(&aabbs) {
+                for (n, a) in v.iter_mut().zip(aabbs) {
                     *n = quantized_node(q, a, n.data);
                 }
                 if let WideNodes::Quantized(w) = &mut self.wide {
@@ -365,7 +372,7 @@ impl Bvh {
                 }
             }
             Nodes::Unquantized(v) => {
-                for (n, a) in v.iter_mut().zip(&aabbs) {
+                for (n, a) in v.iter_mut().zip(aabbs) {
                     *n = unquantized_node(a, n.data);
                 }
                 // The wide nodes keep their topology (see `refit_real`).
@@ -453,7 +460,8 @@ impl Bvh {
             );
         }
         // The structure is checked above, so the fit's indices are in bounds.
-        let aabbs = with_nodes!(self, ns => fit_node_boxes(&ns, &self.order, boxes));
+        let mut aabbs = Vec::new();
+        with_nodes!(self, ns => fit_node_boxes(&ns, &self.order, boxes, &mut aabbs));
         if aabbs[0] != self.bounds {
             return bad(
                 "bounds",
@@ -561,9 +569,11 @@ fn unquantized_node(a: &Aabb, data: u32) -> UnquantizedNode {
 }
 
 /// The exact box of every node of `ns` over the primitive `boxes` (leaves in `order`),
-/// fitted bottom-up: a node's children follow it in the depth-first layout.
-fn fit_node_boxes(ns: &impl NodeSet, order: &[u32], boxes: &[Aabb]) -> Vec<Aabb> {
-    let mut aabbs = vec![Aabb::EMPTY; ns.len()];
+/// fitted bottom-up into `aabbs` (resized to the node count): a node's children follow it
+/// in the depth-first layout.
+fn fit_node_boxes(ns: &impl NodeSet, order: &[u32], boxes: &[Aabb], aabbs: &mut Vec<Aabb>) {
+    aabbs.clear();
+    aabbs.resize(ns.len(), Aabb::EMPTY);
     for i in (0..aabbs.len()).rev() {
         let d = ns.data(i);
         aabbs[i] = if d & LEAF_FLAG != 0 {
@@ -575,7 +585,6 @@ fn fit_node_boxes(ns: &impl NodeSet, order: &[u32], boxes: &[Aabb]) -> Vec<Aabb>
             aabbs[i + 1].merge(&aabbs[right_child_of(ns, i)])
         };
     }
-    aabbs
 }
 
 #[cfg(test)]

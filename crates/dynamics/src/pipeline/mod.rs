@@ -47,6 +47,7 @@ mod contacts;
 #[cfg(test)]
 mod contacts_tests;
 pub mod queries;
+mod query_cache;
 mod scene;
 pub mod snapshot;
 mod step;
@@ -122,7 +123,7 @@ pub struct World {
     accumulator: Real,
     report: PipelineReport,
     /// The scene-query tree kept between [`World::query`] calls.
-    query_cache: queries::QueryCache,
+    query_cache: query_cache::QueryCache,
 }
 
 impl World {
@@ -186,6 +187,7 @@ impl World {
 
     /// The bodies, to set velocities, apply forces and impulses, teleport or wake them.
     pub fn bodies_mut(&mut self) -> &mut BodySet {
+        self.query_cache.moved();
         self.dynamics.bodies_mut()
     }
 
@@ -216,6 +218,7 @@ impl World {
     /// changes.
     pub fn add_body(&mut self, desc: &BodyDesc) -> Result<BodyHandle> {
         let h = self.dynamics.create_body(desc)?;
+        self.query_cache.moved();
         let i = h.index as usize;
         let cap = self.bodies().capacity();
         if self.object_of.len() < cap {
@@ -259,6 +262,7 @@ impl World {
     pub fn remove_body(&mut self, h: BodyHandle) -> Result<Vec<JointHandle>> {
         let i = self.bodies().slot(h)?;
         let joints = self.dynamics.remove_body(h)?;
+        self.query_cache.moved();
         if let Some(obj) = self.object_of[i].take() {
             self.collision.remove(obj)?;
             self.body_of[obj.index as usize] = None;
@@ -270,6 +274,7 @@ impl World {
     /// Sets the pose of a body and of its collision object (teleport); wakes the body.
     pub fn set_pose(&mut self, h: BodyHandle, pose: Isometry) -> Result<()> {
         self.dynamics.bodies_mut().set_pose(h, pose)?;
+        self.query_cache.moved();
         if let Some(obj) = self.object(h)? {
             let pose = self.bodies().pose(h)?;
             self.collision.set_pose(obj, pose)?;

@@ -12,8 +12,10 @@
 //! [`WorldQuery`] keeps the tree for many queries against the same state (the batch form
 //! builds one for its whole batch).
 //!
-//! The world keeps the tree between queries (`QueryCache`): when the same bodies are
-//! queried again, it is reused as is if no box changed, refitted to the new boxes otherwise
+//! The world keeps the tree between queries (`QueryCache`, in `query_cache.rs`, which also
+//! has the step keep a used tree current, so that a query right after a step only takes it,
+//! as the peers' broadphase trees are kept by their steps): when the same bodies are
+//! queried again, it is reused as is if no body moved, refitted to the new boxes otherwise
 //! (`Bvh::refit`, about a seventieth of a build's instructions for 1000 bodies), and
 //! rebuilt when the refitted tree's node area (`Bvh::node_area`, the surface area
 //! heuristic's cost for a fixed topology) has grown past `QueryCache::REBUILD_GROWTH`
@@ -37,14 +39,15 @@
 //! Poses are the bodies' current poses (what [`World::bodies`] reports, including teleports
 //! since the last step), not the collision objects' poses of the last step.
 
+use super::query_cache::{place, CachedTree, QueryCache};
 use super::World;
 use crate::body_set::BodyHandle;
 use carom_collision::math::{check_finite_vec, check_isometry, Aabb, Isometry, Mat3, Real, Vec3};
-use carom_collision::midphase::{Bvh, BvhLayout};
+use carom_collision::midphase::Bvh;
 use carom_collision::query::{raycast_ray, shape_cast, Ray, RayHit, ShapeCastHit};
 use carom_collision::shape::Shape;
 use carom_collision::{CaromError, Result};
-use std::sync::{Arc, Mutex};
+use std::sync::Arc;
 
 /// A ray hit on a body.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -74,9 +77,21 @@ pub struct WorldQuery<'w> {
     /// Per body: what does not change while the world's objects stay the same.
     items: Vec<QueryItem>,
     bvh: Option<Bvh>,
-    /// Where the tree and the items go back when the query is dropped, with the objects'
-    /// stamp, the boxes the tree was fitted to and its node area when built.
-    cache: Option<(&'w QueryCache, u64, Vec<Aabb>, Real)>,
+    /// Where the tree and the items go back when the query is dropped.
+    cache: Option<Kept<'w>>,
+}
+
+/// What a [`WorldQuery`] hands back to the world's cache with its tree, items and objects:
+/// the objects' stamp, the boxes the tree was fitted to, its node area when built, and the
+/// spare boxes buffer.
+#[derive(Debug)]
+struct Kept<'w> {
+    cache: &'w QueryCache,
+    stamp: u64,
+    boxes: Vec<Aabb>,
+    built_area: Real,
+    spare: Vec<Aabb>,
+    scratch: Vec<Aabb>,
 }
 
 /// A body as a query sees it at its current pose: the pose, and a ball around the shape
@@ -84,11 +99,11 @@ pub struct WorldQuery<'w> {
 /// the shape's exact test when it clearly passes by; with the body's collision group, so
 /// that the test of a candidate reads this one record.
 #[derive(Debug, Clone, Copy)]
-struct QueryObject {
-    pose: Isometry,
-    center: Vec3,
-    radius: Real,
-    group: u32,
+pub(super) struct QueryObject {
+    pub(super) pose: Isometry,
+    pub(super) center: Vec3,
+    pub(super) radius: Real,
+    pub(super) group: u32,
 }
 
 /// What a query needs of a body that stays the same while the collision world's objects,
@@ -97,16 +112,16 @@ struct QueryObject {
 /// object-to-body map and the shapes' boxes were most of the query's build, and most of its
 /// cache misses after a step).
 #[derive(Debug, Clone)]
-struct QueryItem {
-    body: BodyHandle,
+pub(super) struct QueryItem {
+    pub(super) body: BodyHandle,
     shape: Arc<Shape>,
     /// The collision object's filter groups (what a query's mask tests).
-    group: u32,
+    pub(super) group: u32,
     /// The shape's local box: centre and half extents (unused for planes).
     local_center: Vec3,
     local_half: Vec3,
     /// The ball's radius: the local box's half diagonal, infinite for planes.
-    radius: Real,
+    pub(super) radius: Real,
 }
 
 impl QueryItem {
@@ -116,7 +131,7 @@ impl QueryItem {
     /// the same matrix as its half extents (`Aabb::transformed` rotates it by the quaternion
     /// as well); planes are unbounded, so they keep their own box.
     #[inline]
-    fn placed(&self, pose: &Isometry) -> (Aabb, Vec3) {
+    pub(super) fn placed(&self, pose: &Isometry) -> (Aabb, Vec3) {
         if let Shape::Plane(_) = &*self.shape {
             return (self.shape.aabb(pose), pose.translation);
         }
@@ -145,110 +160,21 @@ fn misses_ball(ray: &Ray, center: Vec3, radius: Real, max_t: Real) -> bool {
     m.cross(ray.dir).length_squared() > r * r || along + r < 0.0 || along - r > max_t
 }
 
-/// The tree and the per-body items of the last [`World::query`], kept for the next one
-/// (see the module docs). Cloning a world gives the clone an empty cache.
-#[derive(Default)]
-pub(crate) struct QueryCache {
-    slot: Mutex<Option<CachedTree>>,
-}
-
-/// A tree with the boxes it was fitted to and its node area when built, the items of the
-/// bodies it covers (in its primitive order) with the collision world's objects stamp they
-/// were read at, and the objects buffer of the last query (reused).
-struct CachedTree {
-    bvh: Bvh,
-    stamp: u64,
-    items: Vec<QueryItem>,
-    boxes: Vec<Aabb>,
-    built_area: Real,
-    objects: Vec<QueryObject>,
-}
-
-/// A cached tree for bodies that are still the same: the tree, the boxes it was fitted to
-/// and its node area when built.
-type PreviousTree = (Bvh, Vec<Aabb>, Real);
-
-impl QueryCache {
-    /// How much a refitted tree's node area may grow over its build's before the next query
-    /// rebuilds it.
-    pub const REBUILD_GROWTH: Real = 1.25;
-
-    /// Largest number of bodies in a leaf of the tree. An exact body test costs far more
-    /// than a node visit, so the leaves are smaller than a mesh's (8 triangles): the
-    /// closest-first walk then orders nearly every body by its box entry. Two rather than
-    /// one, which doubles the nodes each refit goes through: callgrind, the 500-ray batch
-    /// of the raytests scene with its tree (40 batches after 100 steps), 137.6 M
-    /// instructions with leaves of 8, 138.8 M with 1, 131.4 M with 2.
-    pub const LEAF_SIZE: usize = 2;
-
-    /// The tree's node layout: unquantised (`f32` boxes in its 4-wide nodes). A mesh's
-    /// tree is quantised to halve its memory; this one is small (about 170 wide nodes for
-    /// 1000 bodies, 22 KB) and refitted before nearly every query, where quantising every
-    /// node was half the refit, and its rays then converted the planes of every node they
-    /// visited. Callgrind, the 500-ray batch of the raytests scene with its tree (40
-    /// batches after 100 steps): 130.6 M instructions quantised, 120.7 M unquantised.
-    pub const LAYOUT: BvhLayout = BvhLayout::Unquantized;
-
-    /// The tree over `boxes`: `previous` (a tree of the same bodies) reused when no box
-    /// changed, refitted when some did and it has not grown too much, a new one otherwise;
-    /// with its node area when built.
-    fn tree_for(previous: Option<PreviousTree>, boxes: &[Aabb]) -> Result<(Bvh, Real)> {
-        if let Some((bvh, old_boxes, built_area)) = previous {
-            if old_boxes == boxes {
-                return Ok((bvh, built_area));
-            }
-            let mut bvh = bvh;
-            bvh.refit(boxes)?;
-            if bvh.node_area() <= Self::REBUILD_GROWTH * built_area {
-                return Ok((bvh, built_area));
-            }
-        }
-        let bvh = Bvh::with_max_leaf_size(boxes, QueryCache::LAYOUT, QueryCache::LEAF_SIZE)?;
-        let area = bvh.node_area();
-        Ok((bvh, area))
-    }
-
-    /// Takes the kept tree out (a poisoned lock, after a panic elsewhere while it was held,
-    /// only loses the cache).
-    fn take(&self) -> Option<CachedTree> {
-        self.slot.lock().ok().and_then(|mut g| g.take())
-    }
-
-    /// Keeps `tree` for the next query.
-    fn put(&self, tree: CachedTree) {
-        if let Ok(mut g) = self.slot.lock() {
-            *g = Some(tree);
-        }
-    }
-}
-
-impl Clone for QueryCache {
-    fn clone(&self) -> Self {
-        QueryCache::default()
-    }
-}
-
-impl std::fmt::Debug for QueryCache {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        let cached = self.slot.lock().map(|g| g.is_some()).unwrap_or(false);
-        f.debug_struct("QueryCache")
-            .field("cached", &cached)
-            .finish()
-    }
-}
-
 impl Drop for WorldQuery<'_> {
     fn drop(&mut self) {
-        if let (Some(bvh), Some((cache, stamp, boxes, built_area))) =
-            (self.bvh.take(), self.cache.take())
-        {
-            cache.put(CachedTree {
+        if let (Some(bvh), Some(k)) = (self.bvh.take(), self.cache.take()) {
+            k.cache.put(CachedTree {
                 bvh,
-                stamp,
+                stamp: k.stamp,
                 items: std::mem::take(&mut self.items),
-                boxes,
-                built_area,
+                boxes: k.boxes,
+                built_area: k.built_area,
                 objects: std::mem::take(&mut self.objects),
+                spare: k.spare,
+                scratch: k.scratch,
+                // A query borrows the world: no body moved while it lived.
+                current: true,
+                used: true,
             });
         }
     }
@@ -412,33 +338,42 @@ impl World {
         let set = self.bodies();
         let stamp = self.collision.objects_stamp();
         // The last query's items when the objects are the same (the stamp), its tree when
-        // the bodies are, and its objects buffer in any case.
-        let (items, previous, mut objects) = match self.query_cache.take() {
-            Some(c) if c.stamp == stamp => {
-                (c.items, Some((c.bvh, c.boxes, c.built_area)), c.objects)
+        // the bodies are, and its objects and boxes buffers in any case; all of it as it is
+        // when no body moved since (`CachedTree::current`).
+        let (items, previous, mut objects, spare, mut scratch) = match self.query_cache.take() {
+            Some(c) if c.stamp == stamp && c.current => {
+                return Ok(WorldQuery {
+                    objects: c.objects,
+                    items: c.items,
+                    bvh: Some(c.bvh),
+                    cache: Some(Kept {
+                        cache: &self.query_cache,
+                        stamp,
+                        boxes: c.boxes,
+                        built_area: c.built_area,
+                        spare: c.spare,
+                        scratch: c.scratch,
+                    }),
+                });
             }
+            Some(c) if c.stamp == stamp => (
+                c.items,
+                Some((c.bvh, c.boxes, c.built_area)),
+                c.objects,
+                c.spare,
+                c.scratch,
+            ),
             Some(c) => {
                 let items = self.query_items();
                 let same = items.len() == c.items.len()
                     && items.iter().zip(&c.items).all(|(a, b)| a.body == b.body);
                 let previous = same.then_some((c.bvh, c.boxes, c.built_area));
-                (items, previous, c.objects)
+                (items, previous, c.objects, c.spare, c.scratch)
             }
-            None => (self.query_items(), None, Vec::new()),
+            None => (self.query_items(), None, Vec::new(), Vec::new(), Vec::new()),
         };
-        objects.clear();
-        let mut boxes = Vec::with_capacity(items.len());
-        for item in &items {
-            let pose = set.pose_of(item.body.index as usize);
-            let (world, center) = item.placed(&pose);
-            boxes.push(world);
-            objects.push(QueryObject {
-                pose,
-                center,
-                radius: item.radius,
-                group: item.group,
-            });
-        }
+        let mut boxes = spare;
+        place(&items, set, &mut objects, &mut boxes);
         if boxes.is_empty() {
             return Ok(WorldQuery {
                 objects,
@@ -447,12 +382,29 @@ impl World {
                 cache: None,
             });
         }
-        let (bvh, area) = QueryCache::tree_for(previous, &boxes)?;
+        let (bvh, area, spare) = match previous {
+            Some((bvh, old, built)) => {
+                let previous = Some((bvh, old.as_slice(), built));
+                let (bvh, area) = QueryCache::tree_for(previous, &boxes, &mut scratch)?;
+                (bvh, area, old)
+            }
+            None => {
+                let (bvh, area) = QueryCache::tree_for(None, &boxes, &mut scratch)?;
+                (bvh, area, Vec::new())
+            }
+        };
         Ok(WorldQuery {
             objects,
             items,
             bvh: Some(bvh),
-            cache: Some((&self.query_cache, stamp, boxes, area)),
+            cache: Some(Kept {
+                cache: &self.query_cache,
+                stamp,
+                boxes,
+                built_area: area,
+                spare,
+                scratch,
+            }),
         })
     }
 
@@ -524,16 +476,6 @@ impl World {
 mod tests {
     use super::*;
 
-    /// Unit boxes on a 10 × 10 grid, 3 m apart, each moved by `offset(i)`.
-    fn grid(offset: impl Fn(usize) -> Vec3) -> Vec<Aabb> {
-        (0..100)
-            .map(|i| {
-                let c = Vec3::new((i % 10) as Real * 3.0, 0.0, (i / 10) as Real * 3.0) + offset(i);
-                Aabb::new(c - Vec3::splat(0.5), c + Vec3::splat(0.5))
-            })
-            .collect()
-    }
-
     /// The ball test only turns away rays that miss the ball: every ray the exact ray–ball
     /// interval puts inside the ball within `[0, max_t]` passes, including tangent rays,
     /// rays from inside, rays ending at the ball and everything 10 km out; and it does
@@ -589,56 +531,5 @@ mod tests {
         let ray = Ray::new(Vec3::ZERO, Vec3::X).unwrap();
         assert!(!misses_ball(&ray, Vec3::Y * 1e6, Real::INFINITY, 1.0));
         assert!(!misses_ball(&ray, Vec3::splat(Real::NAN), 1.0, 1.0));
-    }
-
-    /// The cache's rebuild rule: a tree whose boxes jitter is refitted and keeps its build's
-    /// area; one whose boxes swap places across the grid (same bounds, crossing subtrees) has
-    /// grown past `REBUILD_GROWTH` and is rebuilt, with the area of a fresh build; without a
-    /// previous tree (other bodies) it is built afresh. Every tree handed out bounds its
-    /// boxes as a fresh one does.
-    #[test]
-    fn refitted_trees_are_rebuilt_when_their_area_grows() {
-        let fresh_area = |boxes: &[Aabb]| {
-            Bvh::with_max_leaf_size(boxes, QueryCache::LAYOUT, QueryCache::LEAF_SIZE)
-                .unwrap()
-                .node_area()
-        };
-        let first = grid(|_| Vec3::ZERO);
-        let (bvh, built) = QueryCache::tree_for(None, &first).unwrap();
-        assert_eq!(built, fresh_area(&first));
-
-        // The same boxes: the same tree, untouched.
-        let same = bvh.clone();
-        let (bvh, area) = QueryCache::tree_for(Some((bvh, first.clone(), built)), &first).unwrap();
-        assert_eq!(area, built);
-        assert!(bvh == same);
-
-        // Jitter of 2 cm: refitted, the build's area kept, the tree bounds the new boxes.
-        let jitter = grid(|i| Vec3::new(0.02 * (i % 3) as Real, 0.01, -0.02 * (i % 2) as Real));
-        let (bvh, area) = QueryCache::tree_for(Some((bvh, first, built)), &jitter).unwrap();
-        assert_eq!(area, built, "a jittered tree was rebuilt");
-        assert!(bvh.node_area() <= QueryCache::REBUILD_GROWTH * built);
-        let mut seen = [false; 100];
-        for (i, b) in jitter.iter().enumerate() {
-            bvh.for_each_candidate_on_ray(b.center() - Vec3::Y * 5.0, Vec3::Y, 10.0, |p, _| {
-                seen[i] |= p as usize == i;
-                true
-            });
-        }
-        assert!(seen.iter().all(|&s| s), "a refitted tree lost a box");
-
-        // Boxes scrambled across the grid (box i takes the place of 37 i mod 100): the same
-        // bounds, but every subtree now spans the grid; rebuilt.
-        let swapped = grid(|i| {
-            let j = (37 * i) % 100;
-            Vec3::new(
-                (j % 10) as Real * 3.0 - (i % 10) as Real * 3.0,
-                0.0,
-                (j / 10) as Real * 3.0 - (i / 10) as Real * 3.0,
-            )
-        });
-        let (bvh, area) = QueryCache::tree_for(Some((bvh, jitter, area)), &swapped).unwrap();
-        assert_eq!(area, fresh_area(&swapped), "a scrambled tree was kept");
-        assert_eq!(bvh.node_area(), area);
     }
 }

@@ -27,6 +27,9 @@ pub struct PipelineTimings {
     pub integrate: Duration,
     /// Islands, waking, sleeping, storing velocities, joint breaking.
     pub islands: Duration,
+    /// Keeping the scene-query tree current: zero unless a query used it since the last
+    /// step (see `pipeline::query_cache`).
+    pub query_tree: Duration,
     /// The whole step.
     pub total: Duration,
 }
@@ -53,6 +56,9 @@ impl World {
     pub fn step(&mut self, dt: Real) -> Result<&PipelineReport> {
         let dt = Self::check_dt("dt", dt)?;
         let start = Instant::now();
+        // Bodies move from here on; the end of the step refreshes the query tree (an error
+        // in between leaves it stale, never wrong).
+        self.query_cache.moved();
         self.sync(dt)?;
         let t_sync = start.elapsed();
 
@@ -105,6 +111,13 @@ impl World {
             }
         }
 
+        let t = Instant::now();
+        let query_tree = if self.refresh_query_tree() {
+            t.elapsed()
+        } else {
+            Duration::ZERO
+        };
+
         let d = &dyn_report.timings;
         self.report = PipelineReport {
             timings: PipelineTimings {
@@ -115,6 +128,7 @@ impl World {
                 solver: d.forces + d.prepare + d.warm_start + d.solve + d.relax + d.restitution,
                 integrate: d.integrate,
                 islands: d.islands + d.store,
+                query_tree,
                 total: start.elapsed(),
             },
             pairs: self.collision.narrowphase().len(),
