@@ -288,10 +288,10 @@ fn cached_and_fresh(
 #[test]
 fn cached_query_trees_answer_like_fresh_ones() {
     // The world keeps its query tree between calls: reused when no box changed, refitted
-    // when boxes moved, rebuilt when its node area has grown or when the bodies change. A clone starts
-    // without a cache and builds afresh; over 24 steps of falling bodies, with a body removed
-    // and one added on the way, both answer every ray and shape cast identically, and the
-    // hits match the brute force.
+    // when boxes moved, rebuilt when its node area has grown or when the bodies change. A
+    // clone starts without a cache and builds afresh; over 24 steps of falling bodies, with
+    // a body removed and one added on the way, both answer every ray and shape cast
+    // identically, and the hits match the brute force.
     let mut rng = Lcg(3);
     let (mut w, mut hs) = scene(Vec3::ZERO, &mut rng);
     let (origins, dirs) = rays_across(&mut rng, 200);

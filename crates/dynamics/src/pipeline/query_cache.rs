@@ -49,9 +49,10 @@ pub(super) struct CachedTree {
     pub(super) spare: Vec<Aabb>,
     pub(super) scratch: Vec<Aabb>,
     /// The objects, boxes and tree are those of the bodies' poses as they are now: no
-    /// body moved since they were computed. While a [`super::queries::WorldQuery`] lives it borrows the
-    /// world, so nothing can move; every `&mut` method of [`World`] that can move or
-    /// replace a body clears this ([`QueryCache::moved`]), and the step's refresh sets it.
+    /// body moved since they were computed. While a [`super::queries::WorldQuery`] lives
+    /// it borrows the world, so nothing can move; every `&mut` method of [`World`] that
+    /// can move or replace a body clears this ([`QueryCache::moved`]), and the step's
+    /// refresh sets it.
     pub(super) current: bool,
     /// A query used the tree since the last step: the next step refreshes it.
     pub(super) used: bool,
