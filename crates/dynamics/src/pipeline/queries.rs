@@ -83,7 +83,7 @@ pub struct WorldQuery<'w> {
 
 /// What a [`WorldQuery`] hands back to the world's cache with its tree, items and objects:
 /// the objects' stamp, the boxes the tree was fitted to, its node area when built, and the
-/// spare boxes buffer.
+/// buffers of the next refresh (boxes, and the node boxes of a refit).
 #[derive(Debug)]
 struct Kept<'w> {
     cache: &'w QueryCache,
