@@ -144,10 +144,11 @@ pub(crate) fn edge_query(
     if a.flat || b.flat {
         return edge_query_flat(a, b, posed);
     }
-    let (vb, nb) = (&posed.vertices[..], &posed.normals[..]);
+    let nb = &posed.normals[..];
     let mut best = (Real::NEG_INFINITY, 0, 0, Vec3::ZERO);
     let va = a.vertices();
     let a_centre = va.iter().fold(Vec3::ZERO, |s, v| s + *v) / va.len().max(1) as Real;
+    let b_faces = face_edge_masks(b);
     for (i, (ea, fa)) in a.edges().iter().zip(a.edge_faces()).enumerate() {
         let (pa, qa) = (va[ea[0] as usize], va[ea[1] as usize]);
         let (na0, na1) = (
@@ -155,38 +156,121 @@ pub(crate) fn edge_query(
             a.faces()[fa[1] as usize].normal,
         );
         let da = qa - pa;
+        let edge_a = EdgeOf {
+            index: i,
+            p: pa,
+            d: da,
+            n0: na0,
+            n1: na1,
+        };
         // The first condition of Gregorius' test for every B edge at once: B's arc must
         // cross the plane of A's (normal `na1 × na0`), i.e. its two face normals lie strictly
         // on opposite sides. The same dot products as `is_minkowski_face`, so this only
         // skips pairs that test would reject.
-        let masks = side_masks(nb, na1.cross(na0));
-        for (j, (eb, fb)) in b.edges().iter().zip(b.edge_faces()).enumerate() {
-            if let Some((pos, neg)) = masks {
-                let (b0, b1) = (1u64 << fb[0], 1u64 << fb[1]);
-                if !((pos & b0 != 0 && neg & b1 != 0) || (neg & b0 != 0 && pos & b1 != 0)) {
-                    continue;
+        let d = na1.cross(na0);
+        match &b_faces {
+            Some(masks) => {
+                let mut crossing = crossing_edges(nb, masks, d);
+                // Lowest edge first, as the loop below visits them.
+                while crossing != 0 {
+                    edge_pair(
+                        &edge_a,
+                        crossing.trailing_zeros() as usize,
+                        b,
+                        posed,
+                        va,
+                        a_centre,
+                        &mut best,
+                    );
+                    crossing &= crossing - 1;
                 }
             }
-            let (nb0, nb1) = (nb[fb[0] as usize], nb[fb[1] as usize]);
-            if !is_minkowski_face(na0, na1, -nb0, -nb1) {
-                continue;
+            None => {
+                for (j, fb) in b.edge_faces().iter().enumerate() {
+                    if !one_side(None, *fb, nb, d) {
+                        edge_pair(&edge_a, j, b, posed, va, a_centre, &mut best);
+                    }
+                }
             }
-            let (pb, qb) = (vb[eb[0] as usize], vb[eb[1] as usize]);
-            let db = qb - pb;
-            let Some(axis) = pair_axis(da, db) else {
-                continue;
-            };
-            // Gregorius: orient the axis away from A's centre; the edges are the supporting
-            // features of a Minkowski face, so the distance is along them.
-            let ax = if axis.dot(pa - a_centre) < 0.0 {
-                -axis
-            } else {
-                axis
-            };
-            consider(&mut best, ax.dot(pb - pa), (i, j, ax), va, vb);
         }
     }
     best
+}
+
+/// An edge of A in the edge query: its index, first vertex, direction and faces' normals.
+struct EdgeOf {
+    index: usize,
+    p: Vec3,
+    d: Vec3,
+    n0: Vec3,
+    n1: Vec3,
+}
+
+/// The edge query's test of A's edge `ea` against B's edge `j`: when they build a face of
+/// the Minkowski difference (Gregorius' test) and are not parallel, their separation along
+/// the axis oriented away from A's centre is a candidate for `best`.
+#[inline(always)]
+fn edge_pair(
+    ea: &EdgeOf,
+    j: usize,
+    b: &Polyhedron,
+    posed: &PosedPolyhedron,
+    va: &[Vec3],
+    a_centre: Vec3,
+    best: &mut (Real, usize, usize, Vec3),
+) {
+    let (vb, nb) = (&posed.vertices[..], &posed.normals[..]);
+    let (eb, fb) = (b.edges()[j], b.edge_faces()[j]);
+    let (nb0, nb1) = (nb[fb[0] as usize], nb[fb[1] as usize]);
+    if !is_minkowski_face(ea.n0, ea.n1, -nb0, -nb1) {
+        return;
+    }
+    let (pb, qb) = (vb[eb[0] as usize], vb[eb[1] as usize]);
+    let Some(axis) = pair_axis(ea.d, qb - pb) else {
+        return;
+    };
+    // Gregorius: orient the axis away from A's centre; the edges are the supporting
+    // features of a Minkowski face, so the distance is along them.
+    let ax = if axis.dot(ea.p - a_centre) < 0.0 {
+        -axis
+    } else {
+        axis
+    };
+    consider(best, ax.dot(pb - ea.p), (ea.index, j, ax), va, vb);
+}
+
+/// For each face of `p`, the edges whose first face it is and those whose second face it is,
+/// as bit masks over the edges; `None` when `p` has more than 64 faces or edges.
+fn face_edge_masks(p: &Polyhedron) -> Option<SmallVec<[(u64, u64); 64]>> {
+    let (faces, edges) = (p.faces().len(), p.edge_faces().len());
+    if faces > 64 || edges > 64 {
+        return None;
+    }
+    let mut masks: SmallVec<[(u64, u64); 64]> = SmallVec::from_elem((0, 0), faces);
+    for (e, f) in p.edge_faces().iter().enumerate() {
+        masks[f[0] as usize].0 |= 1 << e;
+        masks[f[1] as usize].1 |= 1 << e;
+    }
+    Some(masks)
+}
+
+/// The edges (bits, from [`face_edge_masks`]) whose two faces have normals `normals`
+/// strictly on opposite sides of `d`: one face's `n · d > 0` and the other's `< 0`. The
+/// same edges as testing each edge's faces against [`side_masks`], found with one pass over
+/// the faces instead of one over the edges for every edge of the other shape.
+#[inline]
+fn crossing_edges(normals: &[Vec3], masks: &[(u64, u64)], d: Vec3) -> u64 {
+    let (mut pos0, mut pos1, mut neg0, mut neg1) = (0u64, 0u64, 0u64, 0u64);
+    for (n, &(m0, m1)) in normals.iter().zip(masks) {
+        let x = n.dot(d);
+        let pos = 0u64.wrapping_sub(u64::from(x > 0.0));
+        let neg = 0u64.wrapping_sub(u64::from(x < 0.0));
+        pos0 |= m0 & pos;
+        pos1 |= m1 & pos;
+        neg0 |= m0 & neg;
+        neg1 |= m1 & neg;
+    }
+    (pos0 & neg1) | (neg0 & pos1)
 }
 
 /// The unit axis `da × db` of an edge pair, `None` for (nearly) parallel edges: they form
@@ -305,3 +389,7 @@ fn edge_query_flat(
     }
     best
 }
+
+#[cfg(test)]
+#[path = "polyhedron_sat_tests.rs"]
+mod tests;
