@@ -45,10 +45,6 @@ fn manifold(
         .collect()
 }
 
-fn deepest(cs: &[Contact]) -> Option<Real> {
-    cs.iter().map(|c| c.distance).reduce(Real::min)
-}
-
 /// The seeds tried: none, the unseeded answer's normal (A's frame) and its opposite, a
 /// fixed oblique direction, zero and NaN.
 fn hints(normal: Option<Vec3>) -> Vec<Option<Vec3>> {
@@ -89,14 +85,7 @@ fn check_hints(a: &Shape, b: &Shape, pr: &Params) -> Result<(), TestCaseError> {
                     b.kind_name()
                 ))
             })?;
-        if let (Some(d0), Some(d1)) = (deepest(&base), deepest(&got)) {
-            // Both are the minimum penetration up to the face preference (1e-3 (1 + d)).
-            let slack = tol + 2.0e-3 * (1.0 + r(d0).abs());
-            prop_assert!(
-                (r(d0) - r(d1)).abs() <= slack,
-                "hint {hint:?}: depth {d1} against {d0} unseeded"
-            );
-        }
+        check_same_depth(&base, &got, tol, &format!("hint {hint:?} against unseeded"))?;
     }
     Ok(())
 }

@@ -19,7 +19,7 @@ use super::polyhedron::{
     plane_polyhedron_manifold, polyhedron_manifold_guided, polyhedron_manifold_into, Polyhedron,
     SAT_MAX_EDGE_PAIRS,
 };
-use super::polyhedron_guided::hull_manifold_or_separation;
+use super::polyhedron_guided::hull_manifold_or_separation_warm;
 use super::triangle_cuboid::triangle_cuboid_manifold_into;
 use crate::error::{CaromError, Result};
 use crate::math::{Isometry, Mat3, Real, Vec3, Vec3A};
@@ -577,8 +577,15 @@ impl Dispatcher {
                         (None, Some(s)) => Some(s.axis),
                         (None, None) => None,
                     };
-                    manifold.apart =
-                        hull_manifold_or_separation(a, b, &pose_ab, cfg.prediction, hint, contacts);
+                    manifold.apart = hull_manifold_or_separation_warm(
+                        a,
+                        b,
+                        &pose_ab,
+                        cfg.prediction,
+                        hint,
+                        Some(&mut manifold.warm),
+                        contacts,
+                    );
                     true
                 }
                 _ => self.generate_into_with(a, b, &pose_ab, cfg, manifold.is_empty(), contacts)?,

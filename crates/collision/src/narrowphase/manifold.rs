@@ -6,6 +6,7 @@
 
 use super::contact::{ContactPoint, NO_FEATURE};
 use crate::math::{Isometry, Mat3, Real, Vec3, Vec3A};
+use crate::query::gjk::WarmSimplex;
 use serde::{Deserialize, Serialize};
 
 /// Maximum number of points a manifold keeps after reduction.
@@ -58,6 +59,10 @@ pub struct ContactManifold {
     /// current relative pose, generating again cannot find a point, and the update skips it.
     #[serde(default)]
     pub apart: Option<Separation>,
+    /// The last GJK simplex of a hull pair's contact query (`len == 0` when there is none),
+    /// from which the next query starts (see [`WarmSimplex`]).
+    #[serde(default)]
+    pub warm: WarmSimplex,
 }
 
 /// A separating axis of an apart pair and what it proves (Bullet's

@@ -6,11 +6,12 @@ use super::dispatcher::as_polyhedron;
 use super::manifold::Separation;
 use super::polyhedron::{clip_faces, polyhedron_manifold_into, Polyhedron, FACE_PREFERENCE};
 use crate::math::{Isometry, Real, Vec3};
-use crate::query::contact_convex::{contact_gjk_epa_unguarded_hinted, GjkEpa};
+use crate::query::contact_convex::{contact_gjk_epa_unguarded_warm, GjkEpa};
 use crate::query::contact_cuboid_cuboid::{
     cuboid_cuboid_sat, cuboid_cuboid_witness, Axis, CuboidSat,
 };
 use crate::query::epa::epa;
+use crate::query::gjk::WarmSimplex;
 use crate::query::gjk::{gjk, GjkResult};
 use crate::query::guard::{contact_is_consistent, remeasured_near};
 use crate::query::support_adapters::{Support, Transformed};
@@ -119,13 +120,29 @@ pub fn hull_manifold_or_separation(
     hint: Option<Vec3>,
     out: &mut Vec<(Contact, FeatureId)>,
 ) -> Option<Separation> {
+    hull_manifold_or_separation_warm(a, b, pose_ab, prediction, hint, None, out)
+}
+
+/// [`hull_manifold_or_separation`] keeping the pair's GJK simplex in `warm` between calls
+/// (see [`contact_gjk_epa_unguarded_warm`]): GJK starts from it and leaves its final simplex
+/// there. `warm` must come from earlier calls with the same two shapes, in the same order.
+#[allow(clippy::too_many_arguments)]
+pub fn hull_manifold_or_separation_warm(
+    a: &Shape,
+    b: &Shape,
+    pose_ab: &Isometry,
+    prediction: Real,
+    hint: Option<Vec3>,
+    warm: Option<&mut WarmSimplex>,
+    out: &mut Vec<(Contact, FeatureId)>,
+) -> Option<Separation> {
     let (ca, cb) = (a.as_convex()?, b.as_convex()?);
     let (pa, pb) = (as_polyhedron(ca)?, as_polyhedron(cb)?);
     if pa.flat || pb.flat || pa.edges().len() * pb.edges().len() <= SAT_MAX_EDGE_PAIRS {
         polyhedron_manifold_into(&pa, &pb, pose_ab, prediction, out);
         return None;
     }
-    manifold_or_separation_hinted(&pa, &pb, ca, cb, pose_ab, prediction, hint, out)
+    manifold_or_separation_hinted(&pa, &pb, ca, cb, pose_ab, prediction, hint, warm, out)
 }
 
 /// [`polyhedron_manifold_guided`], returning, when GJK finds the shapes farther apart than
@@ -144,7 +161,7 @@ pub fn polyhedron_manifold_or_separation(
     prediction: Real,
     out: &mut Vec<(Contact, FeatureId)>,
 ) -> Option<Separation> {
-    manifold_or_separation_hinted(a, b, ca, cb, pose_ab, prediction, None, out)
+    manifold_or_separation_hinted(a, b, ca, cb, pose_ab, prediction, None, None, out)
 }
 
 /// [`polyhedron_manifold_or_separation`] with GJK seeded by a guessed normal `hint` (A's
@@ -158,6 +175,7 @@ fn manifold_or_separation_hinted(
     pose_ab: &Isometry,
     prediction: Real,
     hint: Option<Vec3>,
+    warm: Option<&mut WarmSimplex>,
     out: &mut Vec<(Contact, FeatureId)>,
 ) -> Option<Separation> {
     if let (ConvexRef::Cuboid(x), ConvexRef::Cuboid(y)) = (ca, cb) {
@@ -186,7 +204,7 @@ fn manifold_or_separation_hinted(
     if near {
         return None;
     }
-    guided_general(a, b, ca, cb, pose_ab, prediction, hint, out)
+    guided_general(a, b, ca, cb, pose_ab, prediction, hint, warm, out)
 }
 
 /// The separation of `ca` and `cb` (B at `pose_ab`) along `axis` (A's frame, from A towards
@@ -285,6 +303,8 @@ fn large_box_hull(
         &pose_ch,
         prediction,
         hint,
+        // The cut box is a new shape at every call: no simplex of its own to keep.
+        None,
         out,
     );
     for (k, _) in &mut out[start..] {
@@ -300,7 +320,7 @@ fn large_box_hull(
 /// The guided path for pairs other than box–box: GJK/EPA, the guard's check, then clipping;
 /// a separation certificate when GJK finds the shapes apart (see
 /// [`polyhedron_manifold_or_separation`]). `hint` seeds GJK (see
-/// [`contact_gjk_epa_unguarded_hinted`]).
+/// [`crate::query::contact_convex::contact_gjk_epa_unguarded_hinted`]).
 #[allow(clippy::too_many_arguments)]
 fn guided_general(
     a: &Polyhedron,
@@ -310,13 +330,14 @@ fn guided_general(
     pose_ab: &Isometry,
     prediction: Real,
     hint: Option<Vec3>,
+    warm: Option<&mut WarmSimplex>,
     out: &mut Vec<(Contact, FeatureId)>,
 ) -> Option<Separation> {
     // GJK/EPA unguarded, then the guard's one check: the shapes' exact separation along the
     // returned normal must be the returned distance; when it is not (EPA on a degenerate
     // polytope, e.g. shapes touching within round-off), the full separating-axis test runs
     // instead (the guard's own fallback for polyhedra, here giving the whole manifold).
-    let c = match contact_gjk_epa_unguarded_hinted(ca, cb, pose_ab, prediction, hint) {
+    let c = match contact_gjk_epa_unguarded_warm(ca, cb, pose_ab, prediction, hint, warm) {
         (GjkEpa::Beyond, axis) => return separation_along(ca, cb, pose_ab, axis, prediction),
         (GjkEpa::Separated(c) | GjkEpa::Penetrating(c), _) => c,
     };

@@ -123,7 +123,8 @@ fn a_hull_of_many_faces_takes_the_per_edge_path() {
     assert!(face_edge_masks(&b).is_none());
     for k in 0..20 {
         let angle = k as Real * 0.3;
-        let posed = PosedPolyhedron::new(&b, &pose([0.4, -0.2, 0.1], [1.0, 2.0, 0.5], angle), false);
+        let posed =
+            PosedPolyhedron::new(&b, &pose([0.4, -0.2, 0.1], [1.0, 2.0, 0.5], angle), false);
         let (s, i, j, _) = edge_query(&a, &b, &posed);
         let (s0, i0, j0, _) = edge_query_unpruned(&a, &b, &posed);
         assert_eq!((s.to_bits(), i, j), (s0.to_bits(), i0, j0));

@@ -17,7 +17,8 @@
 
 use super::simplex::closest_to_origin;
 use super::support_adapters::{MinkowskiDiff, Support};
-use crate::math::{Real, Vec3, EPSILON};
+use crate::math::{Aabb, Isometry, Real, Vec3, EPSILON};
+use serde::{Deserialize, Serialize};
 
 /// Iteration cap of GJK (a polytope pair converges in far fewer; smooth shapes stop on the
 /// relative tolerance long before).
@@ -106,6 +107,59 @@ impl Simplex {
     }
 }
 
+/// A GJK simplex kept between queries of one pair (see [`gjk_warm`]): its support points on A
+/// in A's frame and on B in B's own frame, so that it can be placed at the pair's next
+/// relative pose. Points that are not on the shapes are harmless only in that they cost
+/// iterations; points of other shapes are wrong, so a cache belongs to one pair of shapes.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct WarmSimplex {
+    /// Number of points in use (at most 4).
+    pub len: u8,
+    /// Points of A, in A's frame.
+    pub a: [Vec3; 4],
+    /// Points of B, in B's frame.
+    pub b: [Vec3; 4],
+}
+
+impl WarmSimplex {
+    /// The points of `simplex` (A's frame, B at `pose_ab`), B's taken back to B's frame.
+    pub fn keep(simplex: &Simplex, pose_ab: &Isometry) -> Self {
+        let mut out = WarmSimplex {
+            len: simplex.len.min(4) as u8,
+            ..Default::default()
+        };
+        for i in 0..out.len as usize {
+            out.a[i] = simplex.a[i];
+            out.b[i] = pose_ab.inverse_transform_point(simplex.b[i]);
+        }
+        out
+    }
+
+    /// True when every point of A lies in `box_a` and every point of B in `box_b` (the
+    /// shapes' local boxes, grown by a relative 1e-4 for the round-off of [`Self::keep`]):
+    /// a cheap check that the simplex was kept for these shapes.
+    pub fn fits(&self, box_a: Aabb, box_b: Aabb) -> bool {
+        let inside = |bx: Aabb, p: Vec3| {
+            let slack = 1e-4 * (1.0 + bx.half_extents().max_element() + p.abs().max_element());
+            p.cmpge(bx.min - Vec3::splat(slack)).all() && p.cmple(bx.max + Vec3::splat(slack)).all()
+        };
+        let n = (self.len as usize).min(4);
+        (0..n).all(|i| inside(box_a, self.a[i]) && inside(box_b, self.b[i]))
+    }
+
+    /// The points placed with B at `pose_ab`, as a simplex for [`gjk_warm`].
+    pub fn placed(&self, pose_ab: &Isometry) -> Simplex {
+        let mut out = Simplex::default();
+        for i in 0..(self.len as usize).min(4) {
+            out.a[i] = self.a[i];
+            out.b[i] = pose_ab.transform_point(self.b[i]);
+            out.w[i] = out.a[i] - out.b[i];
+        }
+        out.len = (self.len as usize).min(4);
+        out
+    }
+}
+
 /// Outcome of [`gjk`].
 #[derive(Debug, Clone, Copy)]
 #[allow(clippy::large_enum_variant)] // returned by value once per query; boxing would allocate
@@ -148,29 +202,66 @@ pub fn gjk_with_direction<A: Support, B: Support>(
     initial_dir: Vec3,
     max_distance: Real,
 ) -> (GjkResult, Vec3) {
+    let (result, v, _) = gjk_warm(a, b, &Simplex::default(), initial_dir, max_distance);
+    (result, v)
+}
+
+/// [`gjk_with_direction`] started from the points of `warm` (A's frame; their `w` is
+/// recomputed as `a - b` and `lambda` ignored), e.g. the last simplex of the same pair a step
+/// ago placed at the new relative pose, instead of from one support point: Box2D's
+/// `b2SimplexCache` and Bullet's cached separating vector. Any points of A and of B make a
+/// valid start (they are points of `A - B`), so only the number of iterations depends on
+/// it. Also returns the final simplex (a tetrahedron holding the origin when overlapping).
+/// An empty or unusable `warm` gives exactly [`gjk_with_direction`]'s search.
+pub fn gjk_warm<A: Support, B: Support>(
+    a: &A,
+    b: &B,
+    warm: &Simplex,
+    initial_dir: Vec3,
+    max_distance: Real,
+) -> (GjkResult, Vec3, Simplex) {
     let diff = MinkowskiDiff { a, b };
-    let d0 = if initial_dir.length_squared() > 0.0 && initial_dir.is_finite() {
-        initial_dir
-    } else {
-        Vec3::X
-    };
     let mut simplex = Simplex::default();
-    let (w, pa, pb) = diff.support_pair(-d0);
-    simplex.push(w, pa, pb);
-    simplex.lambda[0] = 1.0;
-    let mut v = w;
+    for i in 0..warm.len.min(4) {
+        let (pa, pb) = (warm.a[i], warm.b[i]);
+        let w = pa - pb;
+        if w.is_finite() && !simplex.contains(w) {
+            simplex.push(w, pa, pb);
+        }
+    }
+    let mut v = Vec3::ZERO;
+    if simplex.len > 0 {
+        v = simplex.solve();
+        if simplex.len == 4 {
+            return (GjkResult::Overlapping(simplex), v, simplex);
+        }
+        if !v.is_finite() {
+            simplex = Simplex::default();
+        }
+    }
+    if simplex.len == 0 {
+        let d0 = if initial_dir.length_squared() > 0.0 && initial_dir.is_finite() {
+            initial_dir
+        } else {
+            Vec3::X
+        };
+        let (w, pa, pb) = diff.support_pair(-d0);
+        simplex.push(w, pa, pb);
+        simplex.lambda[0] = 1.0;
+        v = w;
+    }
     let mut prev;
-    let mut scale_sq = w.length_squared();
+    let mut scale_sq = simplex.max_norm_sq();
     for _ in 0..GJK_MAX_ITERATIONS {
         let vv = v.length_squared();
         if vv <= GJK_ZERO_TOL * GJK_ZERO_TOL * scale_sq || !vv.is_finite() {
-            return (GjkResult::Overlapping(simplex), v);
+            return (GjkResult::Overlapping(simplex), v, simplex);
         }
         let (w, pa, pb) = diff.support_pair(-v);
         scale_sq = scale_sq.max(w.length_squared());
         let vw = v.dot(w);
         if max_distance.is_finite() && vw > 0.0 && vw * vw > vv * max_distance * max_distance {
-            return (GjkResult::BeyondMaxDistance, v);
+            return (GjkResult::BeyondMaxDistance, v, simplex);
         }
         if vv - vw <= GJK_REL_TOL * vv || simplex.contains(w) {
             break;
@@ -179,7 +270,7 @@ pub fn gjk_with_direction<A: Support, B: Support>(
         simplex.push(w, pa, pb);
         let new_v = simplex.solve();
         if simplex.len == 4 {
-            return (GjkResult::Overlapping(simplex), v);
+            return (GjkResult::Overlapping(simplex), v, simplex);
         }
         let new_vv = new_v.length_squared();
         if new_vv >= vv {
@@ -192,7 +283,7 @@ pub fn gjk_with_direction<A: Support, B: Support>(
     }
     let vv = v.length_squared();
     if vv <= GJK_ZERO_TOL * GJK_ZERO_TOL * scale_sq {
-        return (GjkResult::Overlapping(simplex), v);
+        return (GjkResult::Overlapping(simplex), v, simplex);
     }
     let (point_a, point_b) = simplex.witnesses();
     (
@@ -202,6 +293,7 @@ pub fn gjk_with_direction<A: Support, B: Support>(
             point_b,
         },
         v,
+        simplex,
     )
 }
 

@@ -286,10 +286,19 @@ impl ConvexHull {
     /// Bullet's `btConvexHullComputer`-based shapes and Jolt's `ConvexHullShape`). Each step
     /// strictly increases the dot product, so it ends; it is also capped at the vertex count.
     /// Below the threshold a linear scan is faster. A zero or NaN `dir` gives vertex 0.
+    ///
+    /// Inlined into the support functions with the scan; the climb stays out of line.
+    #[inline]
     pub fn support_vertex(&self, dir: Vec3) -> usize {
         if self.vertices.len() <= Self::HILL_CLIMB_MIN_VERTICES {
             return self.support_vertex_scan(dir);
         }
+        self.support_vertex_climb(dir)
+    }
+
+    /// [`Self::support_vertex`] by hill climbing from vertex 0.
+    #[inline(never)]
+    fn support_vertex_climb(&self, dir: Vec3) -> usize {
         let mut best = 0;
         let mut best_dot = self.vertices[0].dot(dir);
         for _ in 0..self.vertices.len() {
@@ -310,6 +319,7 @@ impl ConvexHull {
 
     /// [`Self::support_vertex`] by scanning every vertex, four at a time (the first of the
     /// largest dot products, as a scalar scan would find).
+    #[inline]
     fn support_vertex_scan(&self, dir: Vec3) -> usize {
         support_index(&self.lanes, dir)
     }

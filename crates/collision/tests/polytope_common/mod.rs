@@ -591,3 +591,27 @@ pub fn check_pair_tilted(
 pub fn hull_of(points: &[Vec3]) -> Shape {
     Shape::ConvexHull(ConvexHull::new(points).unwrap())
 }
+
+/// The deepest point's signed distance of a manifold, `None` for an empty one.
+pub fn deepest(cs: &[Contact]) -> Option<Real> {
+    cs.iter().map(|c| c.distance).reduce(Real::min)
+}
+
+/// Fails unless the deepest points of `base` and `got` (when both have one) agree: both are
+/// the minimum penetration up to the face preference (`1e-3 (1 + d)`) and `tol`. `what`
+/// names `got` in the message.
+pub fn check_same_depth(
+    base: &[Contact],
+    got: &[Contact],
+    tol: f64,
+    what: &str,
+) -> Result<(), TestCaseError> {
+    if let (Some(d0), Some(d1)) = (deepest(base), deepest(got)) {
+        let slack = tol + 2.0e-3 * (1.0 + r(d0).abs());
+        prop_assert!(
+            (r(d0) - r(d1)).abs() <= slack,
+            "{what}: depth {d1} against {d0}"
+        );
+    }
+    Ok(())
+}
