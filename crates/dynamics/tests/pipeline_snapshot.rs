@@ -298,12 +298,14 @@ fn corrupt_and_truncated_bytes_are_errors_not_panics() {
         flipped += 1;
     }
     assert!(flipped > 10);
-    let mut b = bytes.clone();
-    b[10] = 99; // version
-    assert!(World::from_bytes(&b)
-        .unwrap_err()
-        .to_string()
-        .contains("version"));
+    // Another version, including the last one before manifolds kept their GJK simplex
+    // (version 2, whose postcard payload this build would misread).
+    for version in [99u16, 2] {
+        let mut b = bytes.clone();
+        b[10..12].copy_from_slice(&version.to_le_bytes());
+        let e = World::from_bytes(&b).unwrap_err().to_string();
+        assert!(e.contains(&format!("format version {version}")), "{e}");
+    }
     let mut b = bytes.clone();
     b[12] = 2; // precision
     assert!(World::from_bytes(&b)
@@ -314,4 +316,31 @@ fn corrupt_and_truncated_bytes_are_errors_not_panics() {
     b.push(0);
     assert!(World::from_bytes(&b).is_err());
     assert!(World::from_bytes(b"not a world").is_err());
+}
+
+/// Hull pairs keep their GJK simplex in their manifolds (`ContactManifold::warm`), and the
+/// next query starts from it, so a restored world must carry it to continue bit for bit:
+/// "convex pack" (90 hull cells falling into a pile) snapshotted mid-fall.
+#[test]
+fn hull_piles_continue_bit_for_bit_after_restore() {
+    let scene = carom_scenes::bullet::scene(8).unwrap();
+    let mut params = PipelineParams::default();
+    params.dynamics.sleep.enabled = false;
+    let mut w = World::from_scene_with(&scene, params).unwrap();
+    for _ in 0..40 {
+        w.step(scene.dt).unwrap();
+    }
+    let kept = w
+        .collision()
+        .narrowphase()
+        .pairs()
+        .filter(|p| p.manifold.warm.len > 0)
+        .count();
+    assert!(kept > 10, "only {kept} pairs keep a simplex");
+    let mut r = World::from_bytes(&w.to_bytes().unwrap()).unwrap();
+    for step in 0..40 {
+        w.step(scene.dt).unwrap();
+        r.step(scene.dt).unwrap();
+        assert_eq!(w.state_hash(), r.state_hash(), "step {step} after restore");
+    }
 }

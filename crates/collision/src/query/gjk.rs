@@ -109,8 +109,10 @@ impl Simplex {
 
 /// A GJK simplex kept between queries of one pair (see [`gjk_warm`]): its support points on A
 /// in A's frame and on B in B's own frame, so that it can be placed at the pair's next
-/// relative pose. Points that are not on the shapes are harmless only in that they cost
-/// iterations; points of other shapes are wrong, so a cache belongs to one pair of shapes.
+/// relative pose. Any points of the two shapes are a valid start; points that lie off them
+/// (a cache kept for other shapes) are not, so a cache belongs to one pair of shapes
+/// ([`WarmSimplex::fits`] rejects one that is plainly foreign). Round-off from the frame
+/// changes only costs iterations.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
 pub struct WarmSimplex {
     /// Number of points in use (at most 4).

@@ -49,8 +49,10 @@ use std::sync::Arc;
 /// Tag at the start of every world snapshot.
 pub const SNAPSHOT_MAGIC: &[u8; 10] = b"CAROMWORLD";
 /// Version of the snapshot format written by [`World::to_bytes`] (2: manifolds keep their
-/// separation certificate, `ContactManifold::apart`).
-pub const SNAPSHOT_VERSION: u16 = 2;
+/// separation certificate, `ContactManifold::apart`; 3: and their GJK simplex,
+/// `ContactManifold::warm`). The payload is postcard, which has no field names, so a
+/// snapshot of another version is refused rather than misread.
+pub const SNAPSHOT_VERSION: u16 = 3;
 const HEADER_LEN: usize = 10 + 2 + 1 + 8;
 
 #[derive(Serialize, Deserialize)]
