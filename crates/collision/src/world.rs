@@ -42,6 +42,10 @@ impl ObjectHandle {
     }
 }
 
+/// An object's motion over the step and whether it may stop short of it
+/// ([`CollisionObject::motion`], [`CollisionObject::may_stop`]).
+type Motion = (Vec3, bool);
+
 /// One object: a shared shape at a pose, with a collision filter.
 #[derive(Debug, Clone)]
 pub struct CollisionObject {
@@ -69,6 +73,14 @@ pub struct CollisionObject {
     /// own part `max(margin - |motion|, 0)` and swept along the motion (so with a zero
     /// motion, by the whole margin).
     pub motion: Vec3,
+    /// The object's displacement over the coming step may fall anywhere between zero and
+    /// `motion` (a contact may stop it), not just `motion`: a pair then takes the largest
+    /// relative displacement of the cases, e.g. `max(|motion_a - motion_b|, |motion_b|)`
+    /// when only A may stop. A dynamics pipeline sets it for a body that has just landed on
+    /// another, so a body falling with it still gets speculative points against it. False
+    /// by default; it has no effect with a zero motion. The box needs no change: it is
+    /// swept from the pose along the whole motion.
+    pub may_stop: bool,
     /// True when hinted resting ([`CollisionWorld::set_resting`]) or static: pairs of two
     /// such objects are not updated by the narrowphase.
     pub resting: bool,
@@ -81,10 +93,10 @@ impl CollisionObject {
     /// Stores what [`CollisionWorld::sync_object`] computed; the object is up to date (a
     /// pending `set_pose` must not be applied again by `update`).
     #[inline(always)]
-    fn set_synced(&mut self, pose: Isometry, margin: Real, motion: Vec3, aabb: Aabb, d: Vec3) {
+    fn set_synced(&mut self, pose: Isometry, margin: Real, motion: Motion, aabb: Aabb, d: Vec3) {
         self.pose = pose;
         self.margin = margin;
-        self.motion = motion;
+        (self.motion, self.may_stop) = motion;
         self.aabb = aabb;
         self.displacement = d;
         self.dirty = false;
@@ -238,6 +250,7 @@ impl CollisionWorld {
             aabb,
             margin: 0.0,
             motion: Vec3::ZERO,
+            may_stop: false,
             resting: filter.is_static,
             handle,
             dirty: false,
@@ -311,7 +324,8 @@ impl CollisionWorld {
     }
 
     /// Moves an object, sets its speculative margin and motion (see
-    /// [`CollisionObject::margin`] and [`CollisionObject::motion`]), and updates its box and
+    /// [`CollisionObject::margin`], [`CollisionObject::motion`] and
+    /// [`CollisionObject::may_stop`]), and updates its box and
     /// broadphase proxy now instead of at the next [`CollisionWorld::update`]: what
     /// [`CollisionWorld::set_pose_with_margin`] then [`CollisionWorld::set_motion`] do, in one
     /// pass with one handle check (a dynamics pipeline calls it for every moving body at every
@@ -323,6 +337,7 @@ impl CollisionWorld {
         pose: Isometry,
         margin: Real,
         motion: Vec3,
+        may_stop: bool,
     ) -> Result<()> {
         let i = self.slot(h)?;
         let Some(o) = self.objects[i].as_mut() else {
@@ -345,11 +360,11 @@ impl CollisionWorld {
             && (q.length_squared() - 1.0).abs() <= 4.0 * Real::EPSILON
             && aabb.min.cmple(aabb.max).all())
         {
-            return self.sync_object_checked(i, pose, margin, motion);
+            return self.sync_object_checked(i, pose, margin, (motion, may_stop));
         }
         self.broadphase
             .update_proxy_checked(h.proxy(), &aabb, displacement)?;
-        o.set_synced(pose, margin, motion, aabb, displacement);
+        o.set_synced(pose, margin, (motion, may_stop), aabb, displacement);
         Ok(())
     }
 
@@ -363,7 +378,7 @@ impl CollisionWorld {
         i: usize,
         pose: Isometry,
         margin: Real,
-        motion: Vec3,
+        (motion, may_stop): Motion,
     ) -> Result<()> {
         let pose = check_pose_fast(pose)?;
         crate::math::check_non_negative("margin", margin)?;
@@ -378,7 +393,7 @@ impl CollisionWorld {
         crate::math::check_finite_vec("displacement", displacement)?;
         self.broadphase
             .update_proxy_checked(o.handle.proxy(), &aabb, displacement)?;
-        o.set_synced(pose, margin, motion, aabb, displacement);
+        o.set_synced(pose, margin, (motion, may_stop), aabb, displacement);
         Ok(())
     }
 
@@ -482,6 +497,7 @@ impl CollisionWorld {
                 pose: o.pose,
                 margin: o.margin,
                 motion: o.motion,
+                may_stop: o.may_stop,
                 active: !o.resting,
             })
         };

@@ -63,7 +63,7 @@ fn swept_boxes_find_every_pair_that_meets_during_the_step() {
                     w.set_pose_with_margin(h, pose, margin).unwrap();
                     w.set_motion(h, motion).unwrap();
                 } else {
-                    w.sync_object(h, pose, margin, motion).unwrap();
+                    w.sync_object(h, pose, margin, motion, false).unwrap();
                 }
                 let start = own_box(&shape, &pose, margin, motion);
                 movers.push(Mover { h, start, motion });
@@ -109,21 +109,21 @@ fn touching_at_the_end_of_the_step_pairs_and_moving_side_by_side_does_not() {
         // A moves 1 m towards B and ends exactly touching it (dyadic coordinates).
         let a = w.add(cube.clone(), at(0.0), Filter::new(false)).unwrap();
         let b = w.add(cube.clone(), at(2.0), Filter::new(false)).unwrap();
-        w.sync_object(a, at(0.0), 1.0, Vec3::X).unwrap();
-        w.sync_object(b, at(2.0), 0.0, Vec3::ZERO).unwrap();
+        w.sync_object(a, at(0.0), 1.0, Vec3::X, false).unwrap();
+        w.sync_object(b, at(2.0), 0.0, Vec3::ZERO, false).unwrap();
         // C and D fall side by side, 0.25 m apart, at 1 m per step, with a 1 cm margin of
         // their own: the whole margin on every side (the old box) would pair them.
         let c = w.add(cube.clone(), at(10.0), Filter::new(false)).unwrap();
         let d = w.add(cube.clone(), at(11.25), Filter::new(false)).unwrap();
         let down = Vec3::new(0.0, -1.0, 0.0);
-        w.sync_object(c, at(10.0), 1.01, down).unwrap();
-        w.sync_object(d, at(11.25), 1.01, down).unwrap();
+        w.sync_object(c, at(10.0), 1.01, down, false).unwrap();
+        w.sync_object(d, at(11.25), 1.01, down, false).unwrap();
         w.update().unwrap();
         let pairs = w.pairs();
         assert!(pairs.contains(&(a, b)), "{far}: {pairs:?}");
         assert!(!pairs.contains(&(c, d)), "{far}: {pairs:?}");
         // A motion 1 cm short of the contact leaves a 1 cm gap: no pair.
-        w.sync_object(a, at(0.0), 0.99, Vec3::new(0.99, 0.0, 0.0))
+        w.sync_object(a, at(0.0), 0.99, Vec3::new(0.99, 0.0, 0.0), false)
             .unwrap();
         w.update().unwrap();
         assert!(!w.pairs().contains(&(a, b)), "{far}");
@@ -149,4 +149,49 @@ fn a_new_motion_alone_updates_the_box() {
     w.set_motion(h, Vec3::ZERO).unwrap();
     w.update().unwrap();
     assert_eq!(w.get(h).unwrap().aabb, whole);
+}
+
+/// `may_stop`: a pair counts the stop of an object that may stop short of its motion. Two
+/// cubes fall together at 5 cm a step, 4 cm apart, with a 1 cm margin of their own each: by
+/// their relative motion (none) they are 2 cm short of a speculative point. When the lower
+/// one may stop (it has just landed on something), the upper one's whole motion counts
+/// and their facing faces get points; with the upper one stopping instead, the lower one
+/// moves away from it, and its motion counts as well. Near the origin and 1 km from it.
+#[test]
+fn an_object_that_may_stop_gets_points_against_one_falling_with_it() {
+    let cube: Arc<Shape> = Arc::new(Cuboid::new(Vec3::splat(0.5)).unwrap().into());
+    for far in [Vec3::ZERO, Vec3::new(1024.0, 512.0, -2048.0)] {
+        for (lower_stops, upper_stops, points) in [
+            (false, false, false),
+            (true, false, true),
+            (false, true, true),
+            (true, true, true),
+        ] {
+            let mut w = CollisionWorld::new(Method::default());
+            let at = |y: Real| Isometry::new(far + Vec3::new(0.0, y, 0.0), Quat::IDENTITY);
+            let low = w.add(cube.clone(), at(0.0), Filter::new(false)).unwrap();
+            let up = w.add(cube.clone(), at(1.04), Filter::new(false)).unwrap();
+            let down = Vec3::new(0.0, -0.05, 0.0);
+            w.sync_object(low, at(0.0), 0.06, down, lower_stops)
+                .unwrap();
+            w.sync_object(up, at(1.04), 0.06, down, upper_stops)
+                .unwrap();
+            w.update().unwrap();
+            let key = (low.min(up), low.max(up));
+            let found = w
+                .narrowphase()
+                .manifolds()
+                .filter(|p| (p.a, p.b) == key)
+                .map(|p| p.manifold.points.len())
+                .sum::<usize>();
+            assert_eq!(
+                found > 0,
+                points,
+                "{far} lower {lower_stops} upper {upper_stops}: {found} points"
+            );
+            if points {
+                assert_eq!(found, 4, "{far}: the facing faces");
+            }
+        }
+    }
 }

@@ -68,7 +68,7 @@ fn sync_object_equals_the_deferred_updates_for_every_method() {
                         // A pending `set_pose` overridden by the sync in the same frame.
                         a.set_pose(h, random_pose(&mut rng, far)).unwrap();
                     }
-                    a.sync_object(h, pose, margin, motion).unwrap();
+                    a.sync_object(h, pose, margin, motion, false).unwrap();
                     b.set_pose_with_margin(h, pose, margin).unwrap();
                     b.set_motion(h, motion).unwrap();
                 }
@@ -117,7 +117,7 @@ fn sync_object_rejects_bad_input_and_changes_nothing() {
         (huge, Real::MAX, Vec3::ZERO, "aabb"),
     ];
     for (pose, margin, motion, name) in cases {
-        match w.sync_object(h, pose, margin, motion) {
+        match w.sync_object(h, pose, margin, motion, false) {
             Err(CaromError::InvalidValue { name: n, .. }) => assert_eq!(n, name),
             r => panic!("{name}: {r:?}"),
         }
@@ -131,12 +131,12 @@ fn sync_object_rejects_bad_input_and_changes_nothing() {
     // A removed object's handle is unknown.
     w.remove(other).unwrap();
     assert!(matches!(
-        w.sync_object(other, ok, 0.0, Vec3::ZERO),
+        w.sync_object(other, ok, 0.0, Vec3::ZERO, false),
         Err(CaromError::UnknownHandle(_))
     ));
     // A rotation off unit length by more than round-off is renormalised, as `set_pose` does.
     let q = Quat::from_xyzw(0.0, 0.0, 0.0, 1.0005);
-    w.sync_object(h, Isometry::new(Vec3::ZERO, q), 0.0, Vec3::ZERO)
+    w.sync_object(h, Isometry::new(Vec3::ZERO, q), 0.0, Vec3::ZERO, false)
         .unwrap();
     assert!((w.get(h).unwrap().pose.rotation.length() - 1.0).abs() <= 4.0 * Real::EPSILON);
 }
@@ -159,7 +159,7 @@ fn sync_object_accepts_finite_values_whose_sum_overflows() {
         (0.0, 0.0, Vec3::ZERO), // back to the origin: touching zero margin
     ] {
         let pose = Isometry::from_translation(Vec3::new(x, x, 1.0));
-        a.sync_object(ha, pose, margin, motion).unwrap();
+        a.sync_object(ha, pose, margin, motion, false).unwrap();
         b.set_pose_with_margin(hb, pose, margin).unwrap();
         b.set_motion(hb, motion).unwrap();
         b.update().unwrap();

@@ -298,9 +298,9 @@ fn corrupt_and_truncated_bytes_are_errors_not_panics() {
         flipped += 1;
     }
     assert!(flipped > 10);
-    // Another version, including the last one before manifolds kept their GJK simplex
-    // (version 2, whose postcard payload this build would misread).
-    for version in [99u16, 2] {
+    // Another version, including the last ones before manifolds kept their GJK simplex
+    // (2) and before the landed bodies were stored (3): this build would misread them.
+    for version in [99u16, 2, 3] {
         let mut b = bytes.clone();
         b[10..12].copy_from_slice(&version.to_le_bytes());
         let e = World::from_bytes(&b).unwrap_err().to_string();
@@ -339,6 +339,24 @@ fn hull_piles_continue_bit_for_bit_after_restore() {
     assert!(kept > 10, "only {kept} pairs keep a simplex");
     let mut r = World::from_bytes(&w.to_bytes().unwrap()).unwrap();
     for step in 0..40 {
+        w.step(scene.dt).unwrap();
+        r.step(scene.dt).unwrap();
+        assert_eq!(w.state_hash(), r.state_hash(), "step {step} after restore");
+    }
+}
+
+/// Which bodies landed on another in the last step sets the next step's speculative margins
+/// (such a body may stop), so a restored world must carry it: "1000 stack"
+/// snapshotted while the pyramid's layers land one on another.
+#[test]
+fn landing_layers_continue_bit_for_bit_after_restore() {
+    let scene = carom_scenes::bullet::scene(2).unwrap();
+    let mut w = World::from_scene(&scene).unwrap();
+    for _ in 0..12 {
+        w.step(scene.dt).unwrap();
+    }
+    let mut r = World::from_bytes(&w.to_bytes().unwrap()).unwrap();
+    for step in 0..12 {
         w.step(scene.dt).unwrap();
         r.step(scene.dt).unwrap();
         assert_eq!(w.state_hash(), r.state_hash(), "step {step} after restore");

@@ -45,6 +45,10 @@ pub struct NarrowObject<'s> {
     /// `margin_a - |motion_a| + margin_b - |motion_b| + |motion_a - motion_b|`, not the sum
     /// of their own.
     pub motion: Vec3,
+    /// The displacement may fall anywhere between zero and `motion` (a contact may stop the
+    /// object): the pair counts the largest relative displacement of those cases
+    /// (`CollisionObject::may_stop` in the collision world).
+    pub may_stop: bool,
     /// False for objects that do not move (resting or static): a pair of two inactive
     /// objects keeps its manifold (and impulses) unchanged, as sleeping pairs in Box2D and
     /// Bullet are not updated.
@@ -59,6 +63,7 @@ impl<'s> NarrowObject<'s> {
             pose,
             margin: 0.0,
             motion: Vec3::ZERO,
+            may_stop: false,
             active: true,
         }
     }
@@ -474,9 +479,18 @@ impl<H: Copy + Ord + Send + Sync> NarrowPhase<H> {
                 let g = dispatcher.generate(sa, sb, &pa.inv_mul(&pb), true)?;
                 p.touching = g.contacts.iter().any(|(c, _)| c.distance <= 0.0);
             } else {
-                // Relative motion: bodies moving together cannot meet through it.
+                // Relative motion: bodies moving together cannot meet through it, unless
+                // one may stop (the distance is convex in the two displacements, so the
+                // largest relative one is at an end of their ranges).
                 let own = |o: &NarrowObject| (o.margin - o.motion.length()).max(0.0);
-                let prediction = own(&oa) + own(&ob) + (oa.motion - ob.motion).length();
+                let mut relative = (oa.motion - ob.motion).length();
+                if oa.may_stop {
+                    relative = relative.max(ob.motion.length());
+                }
+                if ob.may_stop {
+                    relative = relative.max(oa.motion.length());
+                }
+                let prediction = own(&oa) + own(&ob) + relative;
                 dispatcher.update_manifold_with_prediction(
                     sa,
                     &pa,

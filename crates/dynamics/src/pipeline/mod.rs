@@ -14,7 +14,8 @@
 //! 2. **broadphase and narrowphase** ([`CollisionWorld::update`]): boxes expanded by the
 //!    margins, pairs, persistent manifolds with points up to the two margins apart, with
 //!    the pair's *relative* linear motion `|v_a − v_b|·dt` in place of `(|v_a| + |v_b|)·dt`
-//!    (speculative contacts; bodies moving together get none), updated in parallel over pairs;
+//!    (speculative contacts; bodies moving together get none, unless one of them has just
+//!    landed and may stop: its pairs count that case too), updated in parallel over pairs;
 //! 3. **contacts** (module `contacts`): the persistent manifolds become the solver's
 //!    [`ContactManifold`]s in a reused buffer, skipping sensors, pairs without a dynamic body
 //!    and pairs whose joint disables collisions; their accumulated impulses warm-start;
@@ -110,6 +111,9 @@ pub struct World {
     radius: Vec<Real>,
     /// Whether the body's object is hinted resting in the collision world.
     resting: Vec<bool>,
+    /// Per body slot, whether the body landed on another in the last step (see
+    /// `step::mark_landed`); empty when no contact was solved. Read by the next sync.
+    landed: Vec<bool>,
     /// Solver contacts of the current step (reused buffer).
     contacts: Vec<ContactManifold>,
     /// For each entry of `contacts`, the index of its narrowphase pair (see `contacts.rs`).
@@ -143,6 +147,7 @@ impl World {
             body_of: Vec::new(),
             radius: Vec::new(),
             resting: Vec::new(),
+            landed: Vec::new(),
             contacts: Vec::new(),
             sources: Vec::new(),
             chunk_counts: Vec::new(),
@@ -268,6 +273,9 @@ impl World {
             self.body_of[obj.index as usize] = None;
         }
         self.resting[i] = false;
+        if let Some(p) = self.landed.get_mut(i) {
+            *p = false;
+        }
         Ok(joints)
     }
 

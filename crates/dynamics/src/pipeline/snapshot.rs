@@ -5,7 +5,8 @@
 //! free list, sleep timers, pending forces and user wake-ups), the joints with their
 //! warm-starting impulses and broken flags, the persistent contact manifolds with their
 //! accumulated impulses and cached generation poses, the touching flags and events of every
-//! pair, each collision object's pose, margin, filter and resting hint, the accumulator of
+//! pair, each collision object's pose, margin, filter and resting hint, which bodies landed
+//! on another in the last step (their speculative margins depend on it), the accumulator of
 //! [`World::step_simulation`] and the settings.
 //!
 //! **What is rebuilt instead of stored.** The broadphase's internal structures (trees, grid
@@ -50,9 +51,10 @@ use std::sync::Arc;
 pub const SNAPSHOT_MAGIC: &[u8; 10] = b"CAROMWORLD";
 /// Version of the snapshot format written by [`World::to_bytes`] (2: manifolds keep their
 /// separation certificate, `ContactManifold::apart`; 3: and their GJK simplex,
-/// `ContactManifold::warm`). The payload is postcard, which has no field names, so a
-/// snapshot of another version is refused rather than misread.
-pub const SNAPSHOT_VERSION: u16 = 3;
+/// `ContactManifold::warm`; 4: and which bodies landed in the last step). The payload is
+/// postcard, which has no field names, so a snapshot of another version is refused rather
+/// than misread.
+pub const SNAPSHOT_VERSION: u16 = 4;
 const HEADER_LEN: usize = 10 + 2 + 1 + 8;
 
 #[derive(Serialize, Deserialize)]
@@ -107,6 +109,7 @@ struct Snapshot {
     objects: Vec<ObjectSnap>,
     radius: Vec<Real>,
     resting: Vec<bool>,
+    landed: Vec<bool>,
     accumulator: Real,
     pairs: Vec<PairSnap>,
     events: Vec<EventSnap>,
@@ -221,6 +224,7 @@ impl World {
             objects,
             radius: self.radius.clone(),
             resting: self.resting.clone(),
+            landed: self.landed.clone(),
             accumulator: self.accumulator,
             pairs,
             events,
@@ -318,7 +322,11 @@ fn restore(snap: Snapshot) -> Result<World> {
     };
     let mut bodies = snap.bodies;
     let cap = bodies.capacity();
-    if snap.body_shapes.len() != cap || snap.radius.len() != cap || snap.resting.len() != cap {
+    if snap.body_shapes.len() != cap
+        || snap.radius.len() != cap
+        || snap.resting.len() != cap
+        || snap.landed.len() > cap
+    {
         return Err(corrupt("per-body arrays of different lengths"));
     }
     for (i, s) in snap.body_shapes.iter().enumerate() {
@@ -327,6 +335,7 @@ fn restore(snap: Snapshot) -> Result<World> {
     world.dynamics = DynamicsWorld::from_parts(params.dynamics, bodies, snap.joints)?;
     world.radius = snap.radius;
     world.resting = snap.resting;
+    world.landed = snap.landed;
     world.object_of = vec![None; cap];
     world.accumulator = snap.accumulator;
     if !world.accumulator.is_finite() {

@@ -102,6 +102,7 @@ impl World {
 
         let t = Instant::now();
         self.write_back();
+        self.mark_landed();
         let contacts = gather + t.elapsed();
         // A broken joint lets its bodies collide again from the next step on.
         for &jh in &dyn_report.broken_joints {
@@ -176,6 +177,35 @@ impl World {
         Ok(n)
     }
 
+    /// Marks in `landed` the bodies that landed in this step: a solver contact with a
+    /// speculative point (separation above half the base prediction) that took a positive
+    /// normal impulse. The solver let that gap close in this step, no more, so the bodies
+    /// meet at its end with the approach speed of about `separation / dt`, which the next
+    /// step takes away. Bodies resting or sliding on one another (points at about zero
+    /// separation) are not marked. Leaves `landed` empty when there are no contacts (an
+    /// idle world pays nothing).
+    fn mark_landed(&mut self) {
+        self.landed.clear();
+        if self.contacts.is_empty() {
+            return;
+        }
+        let gap = 0.5 * self.params.manifold.prediction;
+        self.landed.resize(self.object_of.len(), false);
+        for m in &self.contacts {
+            let landed = m
+                .points()
+                .iter()
+                .any(|p| p.separation > gap && p.normal_impulse > 0.0);
+            if landed {
+                for h in [m.body_a, m.body_b] {
+                    if let Some(p) = self.landed.get_mut(h.index as usize) {
+                        *p = true;
+                    }
+                }
+            }
+        }
+    }
+
     /// Copies the poses of moving bodies to their collision objects with speculative margins,
     /// and the sleep state to the broadphase's resting hints.
     #[inline(never)] // its own entry in profiles
@@ -219,9 +249,18 @@ impl World {
                 } else {
                     (0.0, Vec3::ZERO)
                 };
+                // A body that landed on another in the last step may be stopped in this one
+                // while a body moving with it is not (the layers of a pyramid landing one
+                // on another): its pairs count both cases (`may_stop`).
+                let may_stop = self.landed.get(i) == Some(&true);
                 // Pose, margin, motion, box and broadphase proxy in one call.
-                self.collision
-                    .sync_object(obj, pose, base + spin + motion.length(), motion)?;
+                self.collision.sync_object(
+                    obj,
+                    pose,
+                    base + spin + motion.length(),
+                    motion,
+                    may_stop,
+                )?;
             } else {
                 let o = self.collision.get(obj)?;
                 let (teleported, has_motion) = (o.pose != pose, o.motion != Vec3::ZERO);
