@@ -16,16 +16,6 @@ use carom_collision::shape::{ConvexHull, Shape};
 use polytope_common::common::{taru_points, Rng};
 use polytope_common::*;
 use proptest::prelude::*;
-use proptest::test_runner::RngSeed;
-
-fn fixed(cases: u32) -> ProptestConfig {
-    ProptestConfig {
-        cases,
-        rng_seed: RngSeed::Fixed(0x6869_6e74_0009),
-        failure_persistence: None,
-        ..ProptestConfig::default()
-    }
-}
 
 /// The manifold of `a` at `pose_a` and `b` at `pose_b` (world frame, query convention) with
 /// GJK seeded by `hint` (A's frame).
@@ -90,24 +80,12 @@ fn check_hints(a: &Shape, b: &Shape, pr: &Params) -> Result<(), TestCaseError> {
     Ok(())
 }
 
-proptest! {
-    #![proptest_config(fixed(128))]
-
-    #[test]
-    fn hull_hull_manifolds_do_not_depend_on_the_seed(
-        a in hull(6..14), b in hull(6..14), pr in params()
-    ) {
-        check_hints(&a, &b, &pr)?;
-    }
-
-    #[test]
-    fn box_hull_manifolds_do_not_depend_on_the_seed(
-        a in cuboid(), b in hull(6..14), pr in params()
-    ) {
-        check_hints(&a, &b, &pr)?;
-        check_hints(&b, &a, &pr)?;
-    }
-}
+hull_pair_cases!(
+    check_hints,
+    0x6869_6e74_0009,
+    hull_hull_manifolds_do_not_depend_on_the_seed,
+    box_hull_manifolds_do_not_depend_on_the_seed
+);
 
 /// Apart pairs beyond the prediction: no point whatever the seed, also with the seed
 /// pointing away from B.

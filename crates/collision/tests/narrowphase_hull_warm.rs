@@ -17,16 +17,6 @@ use carom_collision::shape::{ConvexHull, Shape};
 use polytope_common::common::{taru_points, Rng};
 use polytope_common::*;
 use proptest::prelude::*;
-use proptest::test_runner::RngSeed;
-
-fn fixed(cases: u32) -> ProptestConfig {
-    ProptestConfig {
-        cases,
-        rng_seed: RngSeed::Fixed(0x7761_726d_0021),
-        failure_persistence: None,
-        ..ProptestConfig::default()
-    }
-}
 
 /// The manifold of `a` at `pose_a` and `b` at `pose_b` (world frame, query convention),
 /// GJK started from `warm` (updated in place) or cold.
@@ -106,24 +96,12 @@ fn check_warm(a: &Shape, b: &Shape, pr: &Params) -> Result<(), TestCaseError> {
     Ok(())
 }
 
-proptest! {
-    #![proptest_config(fixed(128))]
-
-    #[test]
-    fn hull_hull_manifolds_do_not_depend_on_the_kept_simplex(
-        a in hull(6..14), b in hull(6..14), pr in params()
-    ) {
-        check_warm(&a, &b, &pr)?;
-    }
-
-    #[test]
-    fn box_hull_manifolds_do_not_depend_on_the_kept_simplex(
-        a in cuboid(), b in hull(6..14), pr in params()
-    ) {
-        check_warm(&a, &b, &pr)?;
-        check_warm(&b, &a, &pr)?;
-    }
-}
+hull_pair_cases!(
+    check_warm,
+    0x7761_726d_0021,
+    hull_hull_manifolds_do_not_depend_on_the_kept_simplex,
+    box_hull_manifolds_do_not_depend_on_the_kept_simplex
+);
 
 /// A simplex is kept with its points in each shape's own frame, and one whose points do not
 /// lie in the shapes' boxes (kept for other shapes) is not used.

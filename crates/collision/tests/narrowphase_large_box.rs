@@ -14,7 +14,6 @@ use carom_collision::query::Contact;
 use carom_collision::shape::{Cuboid, Shape, SupportMap};
 use polytope_common::*;
 use proptest::prelude::*;
-use proptest::test_runner::RngSeed;
 
 /// How the hull meets the box.
 #[derive(Debug, Clone, Copy)]
@@ -164,18 +163,8 @@ fn check(hull: &Shape, c: &Case) -> Result<(), TestCaseError> {
     Ok(())
 }
 
-/// A fixed seed and no persisted failures (the project's determinism rule).
-fn fixed(cases: u32) -> ProptestConfig {
-    ProptestConfig {
-        cases,
-        rng_seed: RngSeed::Fixed(0x6361_726f_6d08),
-        failure_persistence: None,
-        ..ProptestConfig::default()
-    }
-}
-
 proptest! {
-    #![proptest_config(fixed(400))]
+    #![proptest_config(fixed_seed(400, 0x6361_726f_6d08))]
 
     #[test]
     fn hull_against_large_box_matches_oracle(h in hull(6..24), c in case()) {

@@ -9,21 +9,11 @@ use carom_collision::shape::{Cuboid, Shape, Triangle};
 use polytope_common::common;
 use polytope_common::*;
 use proptest::prelude::*;
-use proptest::test_runner::RngSeed;
 
-/// A fixed seed and no persisted failures: CI runs the same 256 cases on every machine (the
-/// project's determinism rule). `bug_hunt_random_polytope_pairs` below draws fresh cases.
-fn fixed(cases: u32) -> ProptestConfig {
-    ProptestConfig {
-        cases,
-        rng_seed: RngSeed::Fixed(0x6361_726f_6d06),
-        failure_persistence: None,
-        ..ProptestConfig::default()
-    }
-}
-
+// CI runs the same 256 cases on every machine; `bug_hunt_random_polytope_pairs` below draws
+// fresh cases.
 proptest! {
-    #![proptest_config(fixed(256))]
+    #![proptest_config(fixed_seed(256, 0x6361_726f_6d06))]
 
     #[test]
     fn hull_hull_manifolds_match_the_intersection_polytope(
@@ -166,7 +156,7 @@ fn triangle() -> impl Strategy<Value = Shape> {
 }
 
 proptest! {
-    #![proptest_config(fixed(256))]
+    #![proptest_config(fixed_seed(256, 0x6361_726f_6d06))]
 
     #[test]
     fn triangle_face_on_far_manifolds_match_the_intersection_polytope(

@@ -31,6 +31,7 @@ use carom_collision::query::{self, Contact};
 use carom_collision::shape::{ConvexHull, Cuboid, Shape, SupportMap};
 use glam::DVec3;
 use proptest::prelude::*;
+use proptest::test_runner::RngSeed;
 
 #[allow(clippy::unnecessary_cast)] // a no-op in the f64 build
 pub fn d3(v: Vec3) -> DVec3 {
@@ -615,3 +616,39 @@ pub fn check_same_depth(
     }
     Ok(())
 }
+
+/// `cases` cases from the fixed seed `seed`, no persisted failures: CI runs the same cases on
+/// every machine (the project's determinism rule).
+pub fn fixed_seed(cases: u32, seed: u64) -> ProptestConfig {
+    ProptestConfig {
+        cases,
+        rng_seed: RngSeed::Fixed(seed),
+        failure_persistence: None,
+        ..ProptestConfig::default()
+    }
+}
+
+/// The two proptest cases of a property of hull pairs checked by `$check(a, b, params)`:
+/// `$hull_hull` on two random hulls, `$box_hull` on a box and a hull in both orders, 128
+/// cases each from the fixed seed `$seed`.
+#[allow(unused_macros)]
+macro_rules! hull_pair_cases {
+    ($check:ident, $seed:expr, $hull_hull:ident, $box_hull:ident) => {
+        proptest! {
+            #![proptest_config(fixed_seed(128, $seed))]
+
+            #[test]
+            fn $hull_hull(a in hull(6..14), b in hull(6..14), pr in params()) {
+                $check(&a, &b, &pr)?;
+            }
+
+            #[test]
+            fn $box_hull(a in cuboid(), b in hull(6..14), pr in params()) {
+                $check(&a, &b, &pr)?;
+                $check(&b, &a, &pr)?;
+            }
+        }
+    };
+}
+#[allow(unused_imports)]
+pub(crate) use hull_pair_cases;
