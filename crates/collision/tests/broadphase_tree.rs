@@ -621,3 +621,51 @@ fn quiet_updates_report_the_brute_force_pairs() {
         assert!(quiet >= 60, "{quiet} quiet updates");
     }
 }
+
+#[test]
+fn quiet_updates_leave_the_trees_alone_and_moves_resume_their_optimisation() {
+    // An update after which nothing changed neither queries nor re-optimises the trees
+    // (nothing degraded them; an idle world's step paid for re-inserting four leaves per
+    // tree before): the trees stay node for node as they were. The first update after a
+    // move re-inserts leaves again, and the pairs stay the brute-force ones throughout.
+    use carom_collision::broadphase::{BroadPhase, BruteForce, Filter, TreeBroadPhase};
+    let scene = SCENES[0];
+    let mut rng = Rng(4242);
+    let mut tree = TreeBroadPhase::new(InsertStrategy::SurfaceArea, 0.05);
+    let mut oracle = BruteForce::new();
+    let mut live = Vec::new();
+    for _ in 0..200 {
+        let b = random_box(&mut rng, scene);
+        let h = oracle.create_proxy(b, Filter::new(false)).unwrap();
+        tree.create_proxy(b, Filter::new(false)).unwrap();
+        live.push(h);
+    }
+    let snapshot = |t: &TreeBroadPhase| format!("{:?} {:?}", t.tree(0), t.tree(1));
+    for round in 0..3 {
+        for _ in 0..10 {
+            let h = live[rng.below(live.len())];
+            let (nb, d) = moved_box(&mut rng, &oracle.aabb(h).unwrap(), scene);
+            oracle.update_proxy(h, nb, d).unwrap();
+            tree.update_proxy(h, nb, d).unwrap();
+        }
+        let before = snapshot(&tree);
+        assert_eq!(tree.update_pairs(), oracle.update_pairs(), "round {round}");
+        assert_ne!(
+            snapshot(&tree),
+            before,
+            "round {round}: the move re-optimised nothing"
+        );
+        let settled = snapshot(&tree);
+        for quiet in 0..20 {
+            assert_eq!(tree.update_pairs(), oracle.update_pairs(), "quiet {quiet}");
+            assert_eq!(
+                snapshot(&tree),
+                settled,
+                "quiet update {quiet} changed a tree"
+            );
+        }
+        assert_eq!(tree.pairs(), oracle.pairs());
+        tree.tree(0).validate().unwrap();
+        tree.tree(1).validate().unwrap();
+    }
+}

@@ -343,15 +343,16 @@ impl BroadPhase for TreeBroadPhase {
     fn update_pairs(&mut self) -> &PairChanges {
         // No box, filter or proxy changed (and no user filter, which may answer differently
         // from one update to the next): every candidate keeps its boxes and filters, so the
-        // pairs are the last update's (a world whose bodies all sleep).
+        // pairs are the last update's (a world whose bodies all sleep). The trees are not
+        // re-optimised either: nothing degraded them and nothing queries them until a leaf
+        // moves again, and then the incremental optimisation resumes. (Re-inserting four
+        // leaves of each tree was 78 k of the 113 k instructions of an idle step of
+        // "1000 stack".)
         if self.moved.is_empty()
             && !self.removed_since_update
             && !self.changed
             && !self.cache.has_user_filter()
         {
-            for t in &mut self.trees {
-                t.optimize_incremental(self.optimize_per_update);
-            }
             return self.cache.keep_all();
         }
         self.changed = false;
