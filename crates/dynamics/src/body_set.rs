@@ -79,6 +79,12 @@ pub struct BodySet {
     pub(crate) info: Vec<BodyInfo>,
     /// Slots woken by user calls since the last step (reported by the next step).
     pub(crate) woken_by_user: Vec<usize>,
+    /// True when every force and torque accumulator is known to be zero (set by
+    /// [`crate::integrate::clear_forces`] over all slots, cleared by every call that adds a
+    /// force or torque): a step in which nothing moves then skips zeroing them again.
+    /// False (unknown) in a new or restored set; not part of a snapshot.
+    #[serde(skip)]
+    pub(crate) forces_zero: bool,
 }
 
 impl BodySet {
@@ -347,6 +353,7 @@ impl BodySet {
     pub fn add_force(&mut self, h: BodyHandle, f: Vec3) -> Result<()> {
         let i = self.slot(h)?;
         self.force[i] += check_finite_vec("force", f)?;
+        self.forces_zero = false;
         self.wake_slot(i);
         Ok(())
     }
@@ -355,6 +362,7 @@ impl BodySet {
     pub fn add_torque(&mut self, h: BodyHandle, t: Vec3) -> Result<()> {
         let i = self.slot(h)?;
         self.torque[i] += check_finite_vec("torque", t)?;
+        self.forces_zero = false;
         self.wake_slot(i);
         Ok(())
     }
@@ -366,6 +374,7 @@ impl BodySet {
         check_finite_vec("point", point)?;
         self.force[i] += f;
         self.torque[i] += (point - self.position[i]).cross(f);
+        self.forces_zero = false;
         self.wake_slot(i);
         Ok(())
     }

@@ -404,10 +404,16 @@ pub(crate) fn store(set: &mut BodySet, bodies: &[SolverBody]) {
 
 /// Zeroes the force and torque accumulators of slots `..n` (the end of a step; the soft step
 /// stores the velocities and world inertias in its parallel stages and then calls this).
+/// When all of them are known to be zero already ([`BodySet::forces_zero`]), nothing is
+/// written (an idle world's step: 1,077 bodies' 26 kB zeroed again each step before).
 pub(crate) fn clear_forces(set: &mut BodySet, n: usize) {
+    if set.forces_zero {
+        return;
+    }
     let n = n.min(set.force.len()).min(set.torque.len());
     set.force[..n].fill(Vec3::ZERO);
     set.torque[..n].fill(Vec3::ZERO);
+    set.forces_zero = n == set.force.len() && n == set.torque.len();
 }
 
 #[cfg(test)]

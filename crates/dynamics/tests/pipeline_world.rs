@@ -304,3 +304,47 @@ fn steps_of_a_world_asleep_change_nothing() {
         );
     }
 }
+
+/// A force added in a world whose bodies all sleep acts for exactly one step, as in a moving
+/// world: the idle steps before it skip zeroing the (already zero) accumulators, and the
+/// step after it starts from zero again. Oracle: `Δv = F / m · dt` in a world without
+/// gravity or contacts.
+#[test]
+fn a_force_added_to_an_idle_world_acts_for_one_step() {
+    let mut p = PipelineParams::default();
+    p.dynamics.gravity = Vec3::ZERO;
+    p.dynamics.sleep.enabled = true;
+    let mut w = World::new(p).unwrap();
+    // A static body far away (its accumulators are cleared too) and a lone 1 m box.
+    let wall = ground(&mut w, 0.5);
+    let b = dyn_box(&mut w, Vec3::splat(0.5), Vec3::new(0.0, 10.0, 0.0));
+    let dt = 1.0 / 60.0;
+    for _ in 0..120 {
+        w.step(dt).unwrap();
+    }
+    assert!(w.bodies().is_sleeping(b).unwrap());
+    // A force on the static body wakes nothing and never reaches the box.
+    w.bodies_mut()
+        .add_force(wall, Vec3::new(0.0, 1.0e6, 0.0))
+        .unwrap();
+    for _ in 0..3 {
+        w.step(dt).unwrap();
+    }
+    assert!(w.bodies().is_sleeping(b).unwrap());
+    assert_eq!(w.bodies().linear_velocity(b).unwrap(), Vec3::ZERO);
+    let mass = 1000.0;
+    let f = Vec3::new(300.0, 0.0, 0.0);
+    w.bodies_mut().add_force(b, f).unwrap();
+    w.step(dt).unwrap();
+    let v1 = w.bodies().linear_velocity(b).unwrap();
+    let want = f.x / mass * dt;
+    assert!((v1.x - want).abs() <= 1e-5 * want, "{v1} against {want}");
+    for _ in 0..5 {
+        w.step(dt).unwrap();
+        assert_eq!(
+            w.bodies().linear_velocity(b).unwrap(),
+            v1,
+            "the force acted again"
+        );
+    }
+}
