@@ -20,8 +20,8 @@
 //! the Jacobian and error of the next existing one, so the two cannot disagree on the row
 //! order.
 
-use super::generate::{generate, has_point, Frames, Sink};
-use super::Joint;
+use super::generate::{generate, has_point, row_kinds, Frames, Sink};
+use super::{Joint, JointKind};
 use crate::body_set::BodySet;
 use crate::solver::rows::{Block, PairInertia, PointBlock, Row, RowKind};
 use crate::solver::SolverBody;
@@ -119,21 +119,114 @@ pub(crate) fn prepare_joint(
     if joint.broken || !(bodies[a].dynamic || bodies[b].dynamic) {
         return None;
     }
-    let row_start = rows.len();
-    let block_start = blocks.len();
-    let mut jr = JointRows {
-        joint: index,
-        breakable: desc.break_impulse.is_finite(),
-        a,
-        b,
-        rows: row_start..row_start,
-        blocks: block_start..block_start,
-        local_a: desc.frame_a.translation - set.info[a].local_com,
-        local_b: desc.frame_b.translation - set.info[b].local_com,
-        frame_qa: desc.frame_a.rotation,
-        frame_qb: desc.frame_b.rotation,
-        point: None,
-    };
+    let (row_start, block_start) = (rows.len(), blocks.len());
+    let mut jr = JointRows::planned(index, joint, row_start..row_start, block_start..block_start);
+    build_rows(
+        &mut jr,
+        joint,
+        set,
+        (h, impulse_in),
+        &mut Sink::Append(rows),
+    );
+    jr.rows = row_start..rows.len();
+    let own = &mut rows[jr.rows.clone()];
+    warm_impulses(own, joint, impulse_in);
+    block_runs(own, |start, len| blocks.push(Block::new(start, len)));
+    jr.blocks = block_start..blocks.len();
+    if with_masses {
+        masses(&mut jr, rows, blocks, bodies);
+    }
+    Some(jr)
+}
+
+/// How many rows and blocks [`prepare_joint`] gives a joint of type `kind`: fixed by the
+/// description (module `generate`'s `row_kinds`), so a step lays out every joint's ranges
+/// first and then builds the joints in parallel ([`prepare_own`]).
+pub(crate) fn layout(kind: &JointKind) -> (usize, usize) {
+    let (eq, n) = row_kinds(kind);
+    let mut blocks = 0;
+    runs(n, |i| eq[i], |_, _| blocks += 1);
+    (n, blocks)
+}
+
+/// [`prepare_joint`] with masses, for a joint laid out by a plan (`jr` from
+/// [`JointRows::planned`], with the ranges [`layout`] gave it): its rows are built into
+/// `own` and its blocks into `own_blocks` (those ranges of the shared buffers, every slot
+/// overwritten), then their effective masses with the bodies `sa`, `sb`. The same values,
+/// bit for bit, as `prepare_joint`; touches nothing but `jr`, `own` and `own_blocks`, so
+/// the joints of one colour are built in parallel blocks (the soft step's first joint
+/// pass), not one after another before the step.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn prepare_own(
+    jr: &mut JointRows,
+    joint: &Joint,
+    set: &BodySet,
+    (sa, sb): (&SolverBody, &SolverBody),
+    h: Real,
+    impulse_in: Real,
+    own: &mut [Row],
+    own_blocks: &mut [Block],
+) {
+    *jr = JointRows::planned(jr.joint, joint, jr.rows.clone(), jr.blocks.clone());
+    let mut sink = Sink::Fill(own, 0);
+    build_rows(jr, joint, set, (h, impulse_in), &mut sink);
+    debug_assert!(
+        matches!(sink, Sink::Fill(r, n) if n == r.len()),
+        "the layout of {:?} disagrees with its rows",
+        joint.desc.kind
+    );
+    warm_impulses(own, joint, impulse_in);
+    let mut k = 0;
+    block_runs(own, |start, len| {
+        if let Some(b) = own_blocks.get_mut(k) {
+            *b = Block::new(start, len);
+        }
+        k += 1;
+    });
+    debug_assert_eq!(k, own_blocks.len(), "blocks of {:?}", joint.desc.kind);
+    masses_own(jr.point.as_mut(), own, own_blocks, sa, sb);
+}
+
+impl JointRows {
+    /// Joint `index` with the row and block ranges `rows`, `blocks` of the shared buffers;
+    /// its anchors, frame rotations and point block are set when its rows are built
+    /// ([`build_rows`]), so a plan touches nothing but the description.
+    pub(crate) fn planned(
+        index: usize,
+        joint: &Joint,
+        rows: Range<usize>,
+        blocks: Range<usize>,
+    ) -> JointRows {
+        let desc = &joint.desc;
+        JointRows {
+            joint: index,
+            breakable: desc.break_impulse.is_finite(),
+            a: desc.body_a.index as usize,
+            b: desc.body_b.index as usize,
+            rows,
+            blocks,
+            local_a: Vec3::ZERO,
+            local_b: Vec3::ZERO,
+            frame_qa: desc.frame_a.rotation,
+            frame_qb: desc.frame_b.rotation,
+            point: None,
+        }
+    }
+}
+
+/// The anchors relative to the bodies' centres of mass, the frames at the current poses,
+/// the point block of the joints that have one (its warm-start impulse from the stored slot
+/// impulses scaled by `impulse_in`), and the rows through `sink`.
+fn build_rows(
+    jr: &mut JointRows,
+    joint: &Joint,
+    set: &BodySet,
+    (h, impulse_in): (Real, Real),
+    sink: &mut Sink,
+) {
+    let desc = &joint.desc;
+    jr.local_a = desc.frame_a.translation - set.info[jr.a].local_com;
+    jr.local_b = desc.frame_b.translation - set.info[jr.b].local_com;
     let f = jr.frames(set);
     if has_point(&desc.kind) {
         let mut p = PointBlock::new(f.ra, f.rb, f.d, f.axes_a);
@@ -142,31 +235,39 @@ pub(crate) fn prepare_joint(
         p.impulse = f.axes_a[0] * s(0) + f.axes_a[1] * s(3) + f.axes_a[2] * s(6);
         jr.point = Some(p);
     }
-    generate(&desc.kind, &f, h, &mut Sink::Append(rows));
-    jr.rows = row_start..rows.len();
-    let own = &mut rows[jr.rows.clone()];
+    generate(&desc.kind, &f, h, sink);
+}
+
+/// The rows' warm-start impulses: the stored slot impulses scaled by `impulse_in`, clamped
+/// to the rows' bounds.
+fn warm_impulses(own: &mut [Row], joint: &Joint, impulse_in: Real) {
     for row in own.iter_mut() {
         row.impulse = (joint.impulses[row.slot as usize] * impulse_in).clamp(row.lo, row.hi);
     }
-    // Runs of two or three consecutive equality rows become blocks.
+}
+
+/// Calls `block(start, len)` for each block of `own`: runs of two or three consecutive
+/// equality rows.
+fn block_runs(own: &[Row], block: impl FnMut(usize, usize)) {
+    runs(own.len(), |i| own[i].kind == RowKind::Equality, block);
+}
+
+/// The blocks of `n` rows whose row `i` is an equality row when `eq(i)`: the runs of two or
+/// three consecutive equality rows, in order, as `block(start, len)`.
+fn runs(n: usize, eq: impl Fn(usize) -> bool, mut block: impl FnMut(usize, usize)) {
     let mut i = 0;
-    while i < own.len() {
+    while i < n {
         let mut end = i;
-        while end < own.len() && end - i < 3 && own[end].kind == RowKind::Equality {
+        while end < n && end - i < 3 && eq(end) {
             end += 1;
         }
         if end - i >= 2 {
-            blocks.push(Block::new(i, end - i));
+            block(i, end - i);
             i = end;
         } else {
             i = end.max(i + 1);
         }
     }
-    jr.blocks = block_start..blocks.len();
-    if with_masses {
-        masses(&mut jr, rows, blocks, bodies);
-    }
-    Some(jr)
 }
 
 /// [`refresh_own`] on the shared buffers (tests).

@@ -5,7 +5,7 @@
 //! is geometrically undefined at some pose — the cone's swing axis at zero swing — is
 //! emitted inactive instead of being left out).
 
-use super::build::rotation_vector;
+use super::build::{rotation_vector, ROW_SLOTS};
 use super::{Axis, AxisMode, JointKind, Motor};
 use crate::solver::rows::{Row, RowKind};
 use crate::solver::Softness;
@@ -42,10 +42,13 @@ impl Frames {
     }
 }
 
-/// Where generated rows go: appended (preparation), or written over the existing rows from
-/// the given index on, keeping their kinds, bounds and impulses (refresh).
+/// Where generated rows go: appended (preparation), written whole into the slots laid out
+/// for them from the given index on (preparation into a planned range, see [`row_kinds`]),
+/// or written over the existing rows from the given index on, keeping their kinds, bounds
+/// and impulses (refresh).
 pub(super) enum Sink<'a> {
     Append(&'a mut Vec<Row>),
+    Fill(&'a mut [Row], usize),
     Overwrite(&'a mut [Row], usize),
 }
 
@@ -58,6 +61,13 @@ impl Sink<'_> {
             Sink::Append(rows) => {
                 let (kind, max) = kind();
                 rows.push(Row::new(slot as u8, j, c, kind, max));
+            }
+            Sink::Fill(rows, i) => {
+                let (kind, max) = kind();
+                if let Some(row) = rows.get_mut(*i) {
+                    *row = Row::new(slot as u8, j, c, kind, max);
+                }
+                *i += 1;
             }
             Sink::Overwrite(rows, i) => {
                 if let Some(row) = rows.get_mut(*i) {
@@ -75,6 +85,12 @@ impl Sink<'_> {
         let zero = [Vec3A::ZERO; 3];
         match self {
             Sink::Append(rows) => rows.push(Row::new(slot as u8, zero, 0.0, kind, 0.0)),
+            Sink::Fill(rows, i) => {
+                if let Some(row) = rows.get_mut(*i) {
+                    *row = Row::new(slot as u8, zero, 0.0, kind, 0.0);
+                }
+                *i += 1;
+            }
             Sink::Overwrite(rows, i) => {
                 if let Some(row) = rows.get_mut(*i) {
                     row.set(zero, 0.0);
@@ -152,6 +168,86 @@ pub(super) fn generate(kind: &JointKind, f: &Frames, h: Real, sink: &mut Sink) {
             swing2,
             twist,
         } => cone_twist(f, swing1, swing2, twist, sink),
+    }
+}
+
+/// The rows [`generate`] emits for a joint of type `kind`, in emission order, as equality
+/// flags (`true` for an [`RowKind::Equality`] row), and their count. They depend on the
+/// description only (see the module docs), so a step lays out the rows of every joint
+/// before building any, and builds the joints of one colour in parallel blocks. Mirrors
+/// `generate` branch for branch (the tests compare the two for every joint type).
+pub(super) fn row_kinds(kind: &JointKind) -> ([bool; ROW_SLOTS], usize) {
+    let mut list = ([false; ROW_SLOTS], 0);
+    let mut push = |eq: bool| {
+        if let Some(k) = list.0.get_mut(list.1) {
+            *k = eq;
+        }
+        list.1 += 1;
+    };
+    let lock = Axis::default();
+    match *kind {
+        JointKind::Ball => {}
+        JointKind::Fixed => (0..3).for_each(|_| axis_kinds(&lock, &mut push)),
+        JointKind::Slider { limits, motor } => {
+            let x = Axis {
+                mode: limited(limits),
+                motor,
+                spring: None,
+            };
+            for ax in [&x, &lock, &lock, &lock, &lock, &lock] {
+                axis_kinds(ax, &mut push);
+            }
+        }
+        JointKind::Generic6Dof {
+            ref linear,
+            ref angular,
+        } => linear
+            .iter()
+            .chain(angular)
+            .for_each(|ax| axis_kinds(ax, &mut push)),
+        JointKind::Hinge { limits, motor } => {
+            push(true);
+            push(true);
+            let ax = Axis {
+                mode: limited(limits),
+                motor,
+                spring: None,
+            };
+            if !(ax.mode == AxisMode::Free && motor.is_none()) {
+                axis_kinds(&ax, &mut push);
+            }
+        }
+        JointKind::ConeTwist { twist, .. } => {
+            // The swing limit (an inequality row, inactive at zero swing), then the twist:
+            // one equality row for a zero span, else two limits.
+            push(false);
+            if twist == 0.0 {
+                push(true);
+            } else {
+                push(false);
+                push(false);
+            }
+        }
+    }
+    list
+}
+
+/// The kinds of [`axis_rows`]' rows for `ax`.
+fn axis_kinds(ax: &Axis, push: &mut impl FnMut(bool)) {
+    match ax.mode {
+        AxisMode::Locked => {
+            push(true);
+            return;
+        }
+        AxisMode::Free => {}
+        AxisMode::Limited { low, high } if low == high => push(true),
+        AxisMode::Limited { .. } => {
+            push(false);
+            push(false);
+        }
+    }
+    if ax.motor.is_some() || ax.spring.is_some() {
+        push(false);
     }
 }
 

@@ -344,3 +344,135 @@ fn a_singular_block_falls_back_to_rows_and_stays_finite() {
     let impulse = s.joints[0].point.unwrap().impulse;
     assert!(impulse.is_finite() && impulse != Vec3A::ZERO);
 }
+
+/// The kinds of [`kinds`] and every other branch of the row generator: limits without a
+/// motor, a motor without limits, equal limits (one equality row), locked axes, springs.
+fn all_kinds() -> Vec<JointKind> {
+    let motor = Some(Motor {
+        speed: -0.5,
+        max_force: 2.0,
+    });
+    let axis = |mode, motor, spring| Axis {
+        mode,
+        motor,
+        spring,
+    };
+    let spring = Some(Spring {
+        hertz: 2.0,
+        damping_ratio: 1.0,
+        rest: 0.0,
+    });
+    let equal = AxisMode::Limited {
+        low: 0.1,
+        high: 0.1,
+    };
+    let range = AxisMode::Limited {
+        low: -0.1,
+        high: 0.2,
+    };
+    let mut all = kinds();
+    all.extend([
+        JointKind::Hinge {
+            limits: Some((-0.4, 0.9)),
+            motor: None,
+        },
+        JointKind::Hinge {
+            limits: None,
+            motor,
+        },
+        JointKind::Hinge {
+            limits: Some((0.3, 0.3)),
+            motor,
+        },
+        JointKind::Slider {
+            limits: None,
+            motor: None,
+        },
+        JointKind::Slider {
+            limits: Some((0.2, 0.2)),
+            motor: None,
+        },
+        JointKind::Generic6Dof {
+            linear: [
+                axis(equal, None, None),
+                axis(AxisMode::Free, None, spring),
+                axis(range, motor, None),
+            ],
+            angular: [
+                axis(AxisMode::Locked, motor, None),
+                axis(equal, None, spring),
+                axis(AxisMode::Free, None, None),
+            ],
+        },
+        JointKind::Generic6Dof {
+            linear: [Axis::default(); 3],
+            angular: [axis(AxisMode::Free, None, None); 3],
+        },
+    ]);
+    all
+}
+
+#[test]
+fn a_joint_built_in_its_planned_slots_equals_a_prepared_one() {
+    // The soft step lays every joint out from its description (`layout`), then each joint
+    // builds its rows and blocks in the slots laid out for it (`prepare_own`, in parallel
+    // blocks). Oracle: `prepare_joint` appending the rows, with masses. The slots start as
+    // garbage (NaN Jacobians, a motor kind, wrong blocks): every one must be written.
+    use super::build::{layout, prepare_own};
+    use crate::solver::rows::RowKind;
+    for origin in [Vec3::ZERO, Vec3::new(1e3, -2e3, 5e2)] {
+        for kind in all_kinds() {
+            let what = format!("{kind:?} at {origin}");
+            let mut r = rig(kind, origin);
+            {
+                let (_, j) = r.joints.iter_mut().next().unwrap();
+                for (s, x) in j.impulses.iter_mut().enumerate() {
+                    *x = 0.3 * (s as Real - 8.0);
+                }
+            }
+            let mut bodies = Vec::new();
+            integrate::load(&r.set, &mut bodies);
+            let (jr, rows, blocks) = prepare(&r, &bodies);
+            let (_, j) = r.joints.iter().next().unwrap();
+            assert_eq!(layout(&kind), (rows.len(), blocks.len()), "{what}");
+
+            let nan = Vec3A::splat(Real::NAN);
+            let mut junk = Row::new(17, [nan; 3], Real::NAN, RowKind::Motor { speed: 9.0 }, 3.0);
+            junk.impulse = Real::NAN;
+            let mut own = vec![junk; rows.len()];
+            let mut own_blocks = vec![Block::new(1, 3); blocks.len()];
+            let mut planned = JointRows::planned(0, j, 0..rows.len(), 0..blocks.len());
+            let pair = (&bodies[r.a.index as usize], &bodies[r.b.index as usize]);
+            let h = 1.0 / 240.0;
+            prepare_own(
+                &mut planned,
+                j,
+                &r.set,
+                pair,
+                h,
+                0.25,
+                &mut own,
+                &mut own_blocks,
+            );
+
+            assert_same_rows(&rows, &own, &what);
+            assert_same_point(&jr, &planned, &what);
+            assert_eq!(
+                jr.point.map(|p| p.impulse),
+                planned.point.map(|p| p.impulse)
+            );
+            let impulses = |rows: &[Row]| rows.iter().map(|x| x.impulse.to_bits()).collect();
+            let want: Vec<_> = impulses(&rows);
+            assert_eq!(want, impulses(&own), "{what}: warm-start impulses");
+            for (x, y) in blocks.iter().zip(&own_blocks) {
+                let key = |b: &Block| (b.start, b.len, b.valid);
+                assert_eq!(key(x), key(y), "{what}");
+                assert_eq!(x.inv_k, y.inv_k, "{what}");
+            }
+            assert_eq!(
+                (jr.a, jr.b, jr.breakable),
+                (planned.a, planned.b, planned.breakable)
+            );
+        }
+    }
+}

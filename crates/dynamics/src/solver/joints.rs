@@ -11,16 +11,21 @@
 //! alignment, a fixed joint's rotation) are solved as coupled blocks ([`Block`]).
 //!
 //! The rows live in the world-owned [`JointScratch`]: [`prepare`] fills it once per step
-//! in colour order (no allocation once the buffers have grown to the joint count), and the
-//! soft step refreshes the rows in place after each position update (Box3D's split of
-//! `b3PrepareJoint` from the substep solves; module `joint::build`).
+//! in colour order (no allocation once the buffers have grown to the joint count); the soft
+//! step lays the same buffers out with [`plan`] and builds each joint's rows in its first
+//! joint pass, in parallel blocks, then refreshes the rows in place after each position
+//! update (Box3D's split of `b3PrepareJoint` from the substep solves; module
+//! `joint::build`).
 
 use super::coloring::{colour_into, ColourScratch, Colouring};
+use super::rows::RowKind;
 use super::rows::{Block, Motion, PointBlock, Row};
 use super::{Softness, SolverBody};
 use crate::body_set::BodySet;
-use crate::joint::{masses_own, prepare_joint, refresh_own, JointRows, JointSet, ROW_SLOTS};
-use carom_collision::math::{Real, Vec3};
+use crate::joint::{
+    layout, prepare_joint, prepare_own, refresh_own, JointRows, JointSet, ROW_SLOTS,
+};
+use carom_collision::math::{Real, Vec3, Vec3A};
 use std::ops::Range;
 
 /// The joint rows of the current step, reused from step to step: one [`JointRows`] per
@@ -49,14 +54,12 @@ pub(crate) struct JointScratch {
     colour_scratch: ColourScratch,
 }
 
-/// Builds the rows of every active joint for a step with substep `h` (the whole step for
-/// sequential impulses); `impulse_in` converts stored per-step impulses to the solver's
-/// units. The joints are coloured first and built colour by colour, so the rows of a colour
-/// are contiguous and in the order the passes read them. Without `masses` the rows' effective
-/// masses and inertia-weighted Jacobians are left unset: the soft step computes them in its
-/// first joint pass ([`JointView::run`] with `first`), in the colours' parallel blocks
-/// rather than here, serially (about a third of this function's instructions on the
-/// ragdoll scene).
+/// Builds the rows of every active joint, with their effective masses, for a step of `h`
+/// (sequential impulses: one thread, the whole step); `impulse_in` converts stored per-step
+/// impulses to the solver's units. The joints are coloured first and built colour by
+/// colour, so the rows of a colour are contiguous and in the order the passes read them.
+/// The soft step lays the same buffers out with [`plan`] and builds the joints in its
+/// first joint pass instead, in the colours' parallel blocks.
 pub(crate) fn prepare(
     s: &mut JointScratch,
     joints: &JointSet,
@@ -64,12 +67,68 @@ pub(crate) fn prepare(
     bodies: &[SolverBody],
     h: Real,
     impulse_in: Real,
-    masses: bool,
 ) {
     s.joints.clear();
     s.rows.clear();
     s.blocks.clear();
     s.colours.clear();
+    colour_active(s, joints, bodies);
+    for r in &s.colouring.ranges {
+        let start = s.joints.len();
+        for &k in &s.colouring.order[r.clone()] {
+            let index = s.active[k];
+            let Some(j) = joints.get_index(index) else {
+                continue;
+            };
+            let (rows, blocks) = (&mut s.rows, &mut s.blocks);
+            let jr = prepare_joint(index, j, set, bodies, h, impulse_in, rows, blocks, true);
+            if let Some(jr) = jr {
+                s.joints.push(jr);
+            }
+        }
+        s.colours.push(start..s.joints.len());
+    }
+    s.sums.clear();
+    s.sums.resize(s.rows.len(), 0.0);
+}
+
+/// Lays out the step's joints for the soft step, which builds them in its first joint pass
+/// ([`JointView::run`] with `first`, in each colour's parallel blocks): the active joints are
+/// coloured as in [`prepare`], and each gets, in colour order, the ranges of the shared row
+/// and block buffers that [`prepare`] would have appended its rows and blocks to (their
+/// counts depend on the joint's description only, [`layout`]). Only this runs serially:
+/// building the rows one joint after another was about 1.7 M instructions of every step of
+/// "136 ragdolls" (1,360 joints), most of the step's serial preparation.
+pub(crate) fn plan(s: &mut JointScratch, joints: &JointSet, bodies: &[SolverBody]) {
+    colour_active(s, joints, bodies);
+    s.joints.clear();
+    s.colours.clear();
+    let (mut rows, mut blocks) = (0, 0);
+    for r in &s.colouring.ranges {
+        let start = s.joints.len();
+        for &k in &s.colouring.order[r.clone()] {
+            let index = s.active[k];
+            let Some(j) = joints.get_index(index) else {
+                continue;
+            };
+            let (n_rows, n_blocks) = layout(&j.desc.kind);
+            let (r, b) = (rows..rows + n_rows, blocks..blocks + n_blocks);
+            s.joints.push(JointRows::planned(index, j, r, b));
+            (rows, blocks) = (rows + n_rows, blocks + n_blocks);
+        }
+        s.colours.push(start..s.joints.len());
+    }
+    // Every slot is written by the first joint pass: the buffers only change length (no
+    // pass over rows that are about to be overwritten).
+    let idle = Row::new(0, [Vec3A::ZERO; 3], 0.0, RowKind::Equality, 0.0);
+    s.rows.resize(rows, idle);
+    s.blocks.resize(blocks, Block::new(0, 2));
+    s.sums.clear();
+    s.sums.resize(rows, 0.0);
+}
+
+/// The active joints (not broken, a dynamic body) and their colouring.
+fn colour_active(s: &mut JointScratch, joints: &JointSet, bodies: &[SolverBody]) {
     s.active.clear();
     s.pairs.clear();
     for (handle, j) in joints.iter() {
@@ -89,23 +148,6 @@ pub(crate) fn prepare(
         &mut s.colour_scratch,
         &mut s.colouring,
     );
-    for r in &s.colouring.ranges {
-        let start = s.joints.len();
-        for &k in &s.colouring.order[r.clone()] {
-            let index = s.active[k];
-            let Some(j) = joints.get_index(index) else {
-                continue;
-            };
-            let (rows, blocks) = (&mut s.rows, &mut s.blocks);
-            let jr = prepare_joint(index, j, set, bodies, h, impulse_in, rows, blocks, masses);
-            if let Some(jr) = jr {
-                s.joints.push(jr);
-            }
-        }
-        s.colours.push(start..s.joints.len());
-    }
-    s.sums.clear();
-    s.sums.resize(s.rows.len(), 0.0);
 }
 
 impl JointScratch {
@@ -260,7 +302,8 @@ impl JointView {
     /// Runs `pass` on the joints `range` (indices into the scratch's joint list), one after
     /// another: each reads its bodies' velocities, updates them through its rows and writes
     /// them back to the dynamic ones. With `first` (the step's first joint pass after a
-    /// [`prepare`] without masses) each joint first computes its rows' effective masses.
+    /// [`plan`]) each joint first builds its rows and blocks and their effective masses
+    /// ([`prepare_own`], for the substep `h`, warm-start impulses scaled by `impulse_in`).
     ///
     /// # Safety
     /// The scratch behind `self` is alive and unchanged; `bodies` points to `n_bodies`
@@ -278,7 +321,7 @@ impl JointView {
         set: &BodySet,
         joints: &JointSet,
         soft: Softness,
-        inv_h: Real,
+        (h, inv_h, impulse_in): (Real, Real, Real),
     ) {
         assert!(range.end <= self.n_joints);
         for i in range {
@@ -292,7 +335,10 @@ impl JointView {
                 std::slice::from_raw_parts_mut(self.blocks.add(blocks.start), blocks.len());
             let (pa, pb) = (bodies.add(jr.a), bodies.add(jr.b));
             if first {
-                masses_own(jr.point.as_mut(), own, own_blocks, &*pa, &*pb);
+                if let Some(j) = joints.get_index(jr.joint) {
+                    let pair = (&*pa, &*pb);
+                    prepare_own(jr, j, set, pair, h, impulse_in, own, own_blocks);
+                }
             }
             let (mut a, mut b) = (Motion::of(&*pa), Motion::of(&*pb));
             match pass {

@@ -37,7 +37,7 @@ pub(crate) fn step(ctx: &mut StepContext) {
     );
     let (cons, ranges) = (&mut scratch.cons, &scratch.colouring.ranges[..]);
     let rows = &mut *ctx.joint_scratch;
-    joints::prepare(rows, ctx.joints, ctx.set, ctx.bodies, dt, warm, true);
+    joints::prepare(rows, ctx.joints, ctx.set, ctx.bodies, dt, warm);
     rows.order_by_slot();
     lap(&mut t, &mut ctx.timings.prepare);
 

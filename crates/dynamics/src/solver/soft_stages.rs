@@ -449,10 +449,11 @@ impl Shared<'_> {
                 let r = &self.joint_colours[k as usize];
                 let b = block_range(r.len(), blocks, block);
                 let range = r.start + b.start..r.start + b.end;
-                let (soft, inv_h, set) = (c.joint_soft, c.inv_h, &*self.set);
+                let (soft, set) = (c.joint_soft, &*self.set);
+                let steps = (c.h, c.inv_h, c.impulse_in);
                 let (bodies, n) = (self.bodies, self.n_bodies);
                 self.rows
-                    .run(range, pass, first, bodies, n, set, self.joints, soft, inv_h);
+                    .run(range, pass, first, bodies, n, set, self.joints, soft, steps);
             }
             SoftStage::Colour(pass, k) => {
                 let r = &self.colours[k as usize];

@@ -60,8 +60,9 @@ pub(crate) fn step(ctx: &mut StepContext) {
         scratch,
     );
     let rows = &mut *ctx.joint_scratch;
-    // The effective masses are left to the first joint pass (parallel blocks).
-    joints::prepare(rows, ctx.joints, ctx.set, ctx.bodies, h, warm, false);
+    // The rows, blocks and effective masses are built by the first joint pass (parallel
+    // blocks of each colour); only the layout is serial.
+    joints::plan(rows, ctx.joints, ctx.bodies);
 
     let plan = &mut ctx.scratch.stages;
     let colours = if simd {
