@@ -67,7 +67,59 @@ pub(crate) fn rotation_vector(q: Quat) -> Vec3 {
     if s < 1e-12 {
         return 2.0 * v;
     }
-    v * (2.0 * s.atan2(q.w) / s)
+    v * (2.0 * atan2(s, q.w) / s)
+}
+
+/// `y.atan2(x)` for the joint angles, which take it up to seven times per joint and step
+/// (the twist and swing of a cone-twist joint at the preparation and at every substep's
+/// refresh): in the `f32` build a polynomial within 2·10⁻⁸ of `atan` on `[0, 1]`
+/// (Abramowitz and Stegun 4.4.49, eight terms) after the usual octant reduction, about a
+/// quarter of the instructions of libm's `atan2f` (which was 5 % of "136 ragdolls"). The
+/// result is within 3·10⁻⁷ rad of the exact angle (about one unit in the last place of
+/// angles near π; tested against the `f64` `atan2`). Zeros, infinities and NaN take the
+/// standard function, as does the `f64` build.
+#[inline]
+pub(crate) fn atan2(y: Real, x: Real) -> Real {
+    #[cfg(feature = "f64")]
+    {
+        y.atan2(x)
+    }
+    #[cfg(not(feature = "f64"))]
+    {
+        use carom_collision::math::consts::{FRAC_PI_2, PI};
+        let (ax, ay) = (x.abs(), y.abs());
+        let (lo, hi) = (ax.min(ay), ax.max(ay));
+        // Comparisons are false for NaN: both arguments finite, not both zero.
+        if !(ax < Real::INFINITY && ay < Real::INFINITY && hi > 0.0) {
+            return y.atan2(x);
+        }
+        let t = lo / hi;
+        let t2 = t * t;
+        // A&S 4.4.49's coefficients, rounded to f32.
+        const A: [Real; 8] = [
+            -0.333_331_47,
+            0.199_935_51,
+            -0.142_089,
+            0.106_562_64,
+            -0.075_289_64,
+            0.042_909_615,
+            -0.016_165_737,
+            0.002_866_225_8,
+        ];
+        let mut p = A[7];
+        for &a in A[..7].iter().rev() {
+            p = p * t2 + a;
+        }
+        let mut r = t + t * t2 * p;
+        if ay > ax {
+            r = FRAC_PI_2 - r;
+        }
+        if x < 0.0 {
+            r = PI - r;
+        }
+        // The sign of `y`, a zero's included (`atan2(-0, x)` is `-0` or `-π`).
+        r.copysign(y)
+    }
 }
 
 impl JointRows {
@@ -359,6 +411,54 @@ pub(crate) fn masses_own(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn atan2_is_within_3e_7_of_the_exact_angle_everywhere() {
+        // Oracle: the f64 `atan2` of the same (exactly widened) arguments. Every octant and
+        // axis, tiny and huge magnitudes, signed zeros, infinities and NaN.
+        let mut worst: f64 = 0.0;
+        let mut check = |y: Real, x: Real| {
+            let got = atan2(y, x) as f64;
+            let want = (y as f64).atan2(x as f64);
+            if want.is_nan() {
+                assert!(got.is_nan(), "atan2({y}, {x}) = {got}");
+                return;
+            }
+            let err = (got - want).abs();
+            worst = worst.max(err);
+            assert!(err <= 3e-7, "atan2({y}, {x}) = {got}, want {want}");
+            assert_eq!(
+                got.is_sign_negative(),
+                want.is_sign_negative(),
+                "atan2({y}, {x})"
+            );
+        };
+        let n = 20_000;
+        for k in 0..n {
+            let a = (k as f64 / n as f64 - 0.5) * 2.0 * std::f64::consts::PI;
+            for r in [1e-30, 1e-6, 0.7, 1.0, 3.5e4, 1e30] {
+                check((r * a.sin()) as Real, (r * a.cos()) as Real);
+            }
+        }
+        let specials = [
+            0.0,
+            -0.0,
+            1e-45,
+            -1e-45,
+            1.0,
+            -1.0,
+            Real::INFINITY,
+            -Real::INFINITY,
+        ];
+        for &y in &specials {
+            for &x in &specials {
+                check(y, x);
+            }
+        }
+        check(Real::NAN, 1.0);
+        check(1.0, Real::NAN);
+        assert!(worst > 0.0 || cfg!(feature = "f64"));
+    }
 
     #[test]
     fn rotation_vector_is_axis_times_angle() {

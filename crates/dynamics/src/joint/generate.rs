@@ -5,7 +5,7 @@
 //! is geometrically undefined at some pose — the cone's swing axis at zero swing — is
 //! emitted inactive instead of being left out).
 
-use super::build::{rotation_vector, ROW_SLOTS};
+use super::build::{atan2, rotation_vector, ROW_SLOTS};
 use super::{Axis, AxisMode, JointKind, Motor};
 use crate::solver::rows::{Row, RowKind};
 use crate::solver::Softness;
@@ -329,7 +329,7 @@ fn hinge(f: &Frames, limits: Option<(Real, Real)>, motor: Option<Motor>, h: Real
         return;
     }
     let q = f.q_rel;
-    let angle = wrap_angle(2.0 * q.z.atan2(q.w));
+    let angle = wrap_angle(2.0 * atan2(q.z, q.w));
     axis_rows(15, &ax, angle, h, sink, |s, slot, sign, c, kind| {
         s.angular(slot, za * sign, c, kind)
     });
@@ -360,7 +360,7 @@ fn cone_twist(f: &Frames, swing1: Real, swing2: Real, twist: Real, sink: &mut Si
     } else {
         Quat::IDENTITY
     };
-    let twist_angle = wrap_angle(2.0 * q_twist.x.atan2(q_twist.w));
+    let twist_angle = wrap_angle(2.0 * atan2(q_twist.x, q_twist.w));
     let swing = rotation_vector((q * q_twist.conjugate()).normalize());
     let phi = swing.length();
     if phi > 1e-6 {
