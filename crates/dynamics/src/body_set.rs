@@ -85,6 +85,16 @@ pub struct BodySet {
     /// False (unknown) in a new or restored set; not part of a snapshot.
     #[serde(skip)]
     pub(crate) forces_zero: bool,
+    /// True when no body is known to sleep: set by a pass of [`crate::island::needed`]
+    /// that found none, cleared when the islands put a body to sleep (the only writer of a
+    /// `true` sleep flag). False (unknown) in a new or restored set; not part of a snapshot.
+    #[serde(skip)]
+    pub(crate) none_asleep: bool,
+    /// The largest rest timer of an awake dynamic body after the last
+    /// [`crate::island::update_sleep`] with sleeping enabled, `None` (unknown) before it and
+    /// in a restored set: timers only go down between steps, so it bounds them all.
+    #[serde(skip)]
+    pub(crate) max_rest: Option<Real>,
 }
 
 impl BodySet {

@@ -280,7 +280,7 @@ impl DynamicsWorld {
         }
         let mut report = StepReport::default();
         let frozen = stillness == island::Stillness::Frozen;
-        let islands = !stillness.idle() && island::needed(&self.bodies, &self.params.sleep, dt);
+        let islands = !stillness.idle() && self.islands_needed(dt);
         if islands {
             let touching = (contacts, resting);
             island::build(&self.bodies, touching, &self.joints, &mut self.islands);
@@ -295,6 +295,11 @@ impl DynamicsWorld {
             frozen,
             report,
         })
+    }
+
+    /// Whether a step of `dt` needs the islands ([`island::needed`]).
+    pub(crate) fn islands_needed(&mut self, dt: Real) -> bool {
+        island::needed(&mut self.bodies, &self.params.sleep, dt)
     }
 
     /// Every manifold's checks (see [`DynamicsWorld::step_gathered`] for `checked`).

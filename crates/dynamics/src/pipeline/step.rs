@@ -79,7 +79,7 @@ impl World {
             self.resting_pairs.clear();
             true
         } else {
-            let islands = crate::island::needed(bodies, &self.params.dynamics.sleep, dt);
+            let islands = self.dynamics.islands_needed(dt);
             self.gather(islands)
         };
         let mut gather = t.elapsed();
