@@ -153,7 +153,9 @@ impl JointRows {
 /// bounds and spring softness), appending them to `rows` and its blocks to `blocks`;
 /// stored impulses are scaled by `impulse_in`. Returns `None` (and appends nothing) for
 /// broken joints or joints between non-moving bodies. The effective masses are computed
-/// only with `with_masses` (else [`masses_own`] must run before the rows are used).
+/// only with `with_masses` (else [`masses_own`] must run before the rows are used). The
+/// oracle of [`prepare_own`], which the solvers use.
+#[cfg(test)]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn prepare_joint(
     index: usize,
@@ -369,6 +371,7 @@ pub(crate) fn refresh_own(
 
 /// Effective masses: the point block's and each block's `K⁻¹`, the scalar mass of every
 /// other row.
+#[cfg(test)]
 fn masses(jr: &mut JointRows, rows: &mut [Row], blocks: &mut [Block], bodies: &[SolverBody]) {
     let (sa, sb) = (&bodies[jr.a], &bodies[jr.b]);
     masses_own(

@@ -42,11 +42,14 @@ impl Frames {
     }
 }
 
-/// Where generated rows go: appended (preparation), written whole into the slots laid out
-/// for them from the given index on (preparation into a planned range, see [`row_kinds`]),
-/// or written over the existing rows from the given index on, keeping their kinds, bounds
+/// Where generated rows go: appended (the tests' oracle), written whole into the slots laid
+/// out for them from the given index on (preparation into a planned range, see
+/// [`row_kinds`]), or written over the existing rows from the given index on, keeping their kinds, bounds
 /// and impulses (refresh).
 pub(super) enum Sink<'a> {
+    /// Appending is the tests' oracle (`build::prepare_joint`); the solvers fill planned
+    /// slots.
+    #[cfg(test)]
     Append(&'a mut Vec<Row>),
     Fill(&'a mut [Row], usize),
     Overwrite(&'a mut [Row], usize),
@@ -58,6 +61,7 @@ impl Sink<'_> {
     #[inline]
     fn put(&mut self, slot: usize, j: [Vec3A; 3], c: Real, kind: impl FnOnce() -> (RowKind, Real)) {
         match self {
+            #[cfg(test)]
             Sink::Append(rows) => {
                 let (kind, max) = kind();
                 rows.push(Row::new(slot as u8, j, c, kind, max));
@@ -84,6 +88,7 @@ impl Sink<'_> {
     fn put_inactive(&mut self, slot: usize, kind: RowKind) {
         let zero = [Vec3A::ZERO; 3];
         match self {
+            #[cfg(test)]
             Sink::Append(rows) => rows.push(Row::new(slot as u8, zero, 0.0, kind, 0.0)),
             Sink::Fill(rows, i) => {
                 if let Some(row) = rows.get_mut(*i) {

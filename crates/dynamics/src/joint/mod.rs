@@ -14,7 +14,7 @@ mod scene;
 #[cfg(test)]
 mod tests;
 
-pub(crate) use build::{layout, prepare_joint, prepare_own, refresh_own, JointRows, ROW_SLOTS};
+pub(crate) use build::{layout, prepare_own, refresh_own, JointRows, ROW_SLOTS};
 
 use crate::body_set::BodyHandle;
 use carom_collision::math::{check_finite, check_isometry, check_non_negative, Isometry, Real};

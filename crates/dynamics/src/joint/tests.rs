@@ -132,6 +132,27 @@ fn prepare(r: &Rig, bodies: &[SolverBody]) -> (JointRows, Vec<Row>, Vec<Block>) 
     (jr.unwrap(), rows, blocks)
 }
 
+/// A rig of `kind` at `origin` whose joint stores the slot impulses `impulse(slot)`, its
+/// solver bodies, and the joint prepared by the oracle ([`prepare`]).
+#[allow(clippy::type_complexity)]
+fn prepared(
+    kind: JointKind,
+    origin: Vec3,
+    impulse: impl Fn(usize) -> Real,
+) -> (Rig, Vec<SolverBody>, (JointRows, Vec<Row>, Vec<Block>)) {
+    let mut r = rig(kind, origin);
+    {
+        let (_, j) = r.joints.iter_mut().next().unwrap();
+        for (s, x) in j.impulses.iter_mut().enumerate() {
+            *x = impulse(s);
+        }
+    }
+    let mut bodies = Vec::new();
+    integrate::load(&r.set, &mut bodies);
+    let p = prepare(&r, &bodies);
+    (r, bodies, p)
+}
+
 fn moved(r: &mut Rig, turn_b: Quat) {
     let (ia, ib) = (r.a.index as usize, r.b.index as usize);
     r.set.position[ia] += Vec3::new(0.02, -0.03, 0.01);
@@ -172,16 +193,8 @@ fn refresh_equals_a_fresh_preparation_for_every_joint_type() {
     for origin in [Vec3::ZERO, Vec3::new(1e3, -2e3, 5e2)] {
         for kind in kinds() {
             let what = format!("{kind:?} at {origin}");
-            let mut r = rig(kind, origin);
-            {
-                let (_, j) = r.joints.iter_mut().next().unwrap();
-                for (s, x) in j.impulses.iter_mut().enumerate() {
-                    *x = 0.01 * (s as Real + 1.0);
-                }
-            }
-            let mut bodies = Vec::new();
-            integrate::load(&r.set, &mut bodies);
-            let (mut jr, mut rows, mut blocks) = prepare(&r, &bodies);
+            let (mut r, bodies, (mut jr, mut rows, mut blocks)) =
+                prepared(kind, origin, |s| 0.01 * (s as Real + 1.0));
             for row in rows.iter_mut() {
                 row.impulse = (row.impulse + 0.5).clamp(row.lo, row.hi);
             }
@@ -423,16 +436,8 @@ fn a_joint_built_in_its_planned_slots_equals_a_prepared_one() {
     for origin in [Vec3::ZERO, Vec3::new(1e3, -2e3, 5e2)] {
         for kind in all_kinds() {
             let what = format!("{kind:?} at {origin}");
-            let mut r = rig(kind, origin);
-            {
-                let (_, j) = r.joints.iter_mut().next().unwrap();
-                for (s, x) in j.impulses.iter_mut().enumerate() {
-                    *x = 0.3 * (s as Real - 8.0);
-                }
-            }
-            let mut bodies = Vec::new();
-            integrate::load(&r.set, &mut bodies);
-            let (jr, rows, blocks) = prepare(&r, &bodies);
+            let (r, bodies, (jr, rows, blocks)) =
+                prepared(kind, origin, |s| 0.3 * (s as Real - 8.0));
             let (_, j) = r.joints.iter().next().unwrap();
             assert_eq!(layout(&kind), (rows.len(), blocks.len()), "{what}");
 

@@ -22,9 +22,7 @@ use super::rows::RowKind;
 use super::rows::{Block, Motion, PointBlock, Row};
 use super::{Softness, SolverBody};
 use crate::body_set::BodySet;
-use crate::joint::{
-    layout, prepare_joint, prepare_own, refresh_own, JointRows, JointSet, ROW_SLOTS,
-};
+use crate::joint::{layout, prepare_own, refresh_own, JointRows, JointSet, ROW_SLOTS};
 use carom_collision::math::{Real, Vec3, Vec3A};
 use std::ops::Range;
 
@@ -56,10 +54,10 @@ pub(crate) struct JointScratch {
 
 /// Builds the rows of every active joint, with their effective masses, for a step of `h`
 /// (sequential impulses: one thread, the whole step); `impulse_in` converts stored per-step
-/// impulses to the solver's units. The joints are coloured first and built colour by
-/// colour, so the rows of a colour are contiguous and in the order the passes read them.
-/// The soft step lays the same buffers out with [`plan`] and builds the joints in its
-/// first joint pass instead, in the colours' parallel blocks.
+/// impulses to the solver's units: the layout of [`plan`], then every joint built in its
+/// slots one after another, so the rows of a colour are contiguous and in the order the
+/// passes read them. The soft step builds the joints of a plan in its first joint pass
+/// instead, in the colours' parallel blocks.
 pub(crate) fn prepare(
     s: &mut JointScratch,
     joints: &JointSet,
@@ -68,35 +66,28 @@ pub(crate) fn prepare(
     h: Real,
     impulse_in: Real,
 ) {
-    s.joints.clear();
-    s.rows.clear();
-    s.blocks.clear();
-    s.colours.clear();
-    colour_active(s, joints, bodies);
-    for r in &s.colouring.ranges {
-        let start = s.joints.len();
-        for &k in &s.colouring.order[r.clone()] {
-            let index = s.active[k];
-            let Some(j) = joints.get_index(index) else {
-                continue;
-            };
-            let (rows, blocks) = (&mut s.rows, &mut s.blocks);
-            let jr = prepare_joint(index, j, set, bodies, h, impulse_in, rows, blocks, true);
-            if let Some(jr) = jr {
-                s.joints.push(jr);
-            }
-        }
-        s.colours.push(start..s.joints.len());
+    plan(s, joints, bodies);
+    let JointScratch {
+        joints: planned,
+        rows,
+        blocks,
+        ..
+    } = s;
+    for jr in planned.iter_mut() {
+        let Some(j) = joints.get_index(jr.joint) else {
+            continue;
+        };
+        let (own, own_blocks) = (&mut rows[jr.rows.clone()], &mut blocks[jr.blocks.clone()]);
+        let pair = (&bodies[jr.a], &bodies[jr.b]);
+        prepare_own(jr, j, set, pair, h, impulse_in, own, own_blocks);
     }
-    s.sums.clear();
-    s.sums.resize(s.rows.len(), 0.0);
 }
 
 /// Lays out the step's joints for the soft step, which builds them in its first joint pass
-/// ([`JointView::run`] with `first`, in each colour's parallel blocks): the active joints are
-/// coloured as in [`prepare`], and each gets, in colour order, the ranges of the shared row
-/// and block buffers that [`prepare`] would have appended its rows and blocks to (their
-/// counts depend on the joint's description only, [`layout`]). Only this runs serially:
+/// ([`JointView::run`] with `first`, in each colour's parallel blocks): the active joints (not
+/// broken, a dynamic body) are coloured, and each gets, in colour order, the next ranges of
+/// the shared row and block buffers for its rows and blocks (their counts depend on the
+/// joint's description only, [`layout`]). Only this runs serially:
 /// building the rows one joint after another was about 1.7 M instructions of every step of
 /// "136 ragdolls" (1,360 joints), most of the step's serial preparation.
 pub(crate) fn plan(s: &mut JointScratch, joints: &JointSet, bodies: &[SolverBody]) {
