@@ -18,8 +18,7 @@
 //! `joint::build`).
 
 use super::coloring::{colour_into, ColourScratch, Colouring};
-use super::rows::RowKind;
-use super::rows::{Block, Motion, PointBlock, Row};
+use super::rows::{Block, Motion, PointBlock, Row, RowKind};
 use super::{Softness, SolverBody};
 use crate::body_set::BodySet;
 use crate::joint::{layout, prepare_own, refresh_own, JointRows, JointSet, ROW_SLOTS};
