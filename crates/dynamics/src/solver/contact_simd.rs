@@ -365,9 +365,17 @@ fn solve_friction(c: &mut WideConstraint, a: &mut WideBody, b: &mut WideBody, li
         ];
         let max = c.friction * p.normal_impulse;
         let len_sq = new[0] * new[0] + new[1] * new[1];
-        // Lanes inside the cone keep `new` (scale exactly 1); the others are projected.
-        let scale = len_sq.simd_gt(max * max).select(max / len_sq.sqrt(), one);
-        let new = [new[0] * scale, new[1] * scale];
+        // Lanes inside the cone keep `new` (scale exactly 1, and `x · 1` is `x` bit for
+        // bit); the others are projected. The square root and the division are the
+        // slowest instructions of the solve: skipped when every lane sticks, as most
+        // resting contacts do.
+        let outside = len_sq.simd_gt(max * max);
+        let new = if outside.any() {
+            let scale = outside.select(max / len_sq.sqrt(), one);
+            [new[0] * scale, new[1] * scale]
+        } else {
+            new
+        };
         p.tangent_impulse = new;
         let (d0, d1) = (new[0] - old[0], new[1] - old[1]);
         r0.apply_angular(d0, a, b);
