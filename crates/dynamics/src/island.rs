@@ -132,7 +132,7 @@ pub(crate) fn needed(set: &mut BodySet, params: &SleepParams, dt: Real) -> bool 
 
 /// Touching body pairs (slots) of the step: the manifolds with points, then `resting`,
 /// the touching pairs the pipeline did not hand to the solver because neither body is awake
-/// (see `pipeline::contacts::resting_edges`).
+/// (see `pipeline::contacts::push_resting`).
 fn touching<'a>(
     manifolds: &'a [ContactManifold],
     resting: &'a [(usize, usize)],

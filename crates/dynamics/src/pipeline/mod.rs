@@ -118,8 +118,9 @@ pub struct World {
     contacts: Vec<ContactManifold>,
     /// For each entry of `contacts`, the index of its narrowphase pair (see `contacts.rs`).
     sources: Vec<u32>,
-    /// Per chunk of pairs, its first manifold (reused buffer of the parallel gather).
-    chunk_counts: Vec<u32>,
+    /// Per chunk of pairs, its first manifold and first resting edge (reused buffer of the
+    /// parallel gather).
+    chunk_counts: Vec<(u32, u32)>,
     /// Body slots of the touching pairs not handed to the solver because neither body is
     /// awake, for the islands (reused buffer, see `contacts::resting_edges`).
     resting_pairs: Vec<(usize, usize)>,
