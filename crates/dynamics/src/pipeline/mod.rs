@@ -122,7 +122,8 @@ pub struct World {
     /// parallel gather).
     chunk_counts: Vec<(u32, u32)>,
     /// Body slots of the touching pairs not handed to the solver because neither body is
-    /// awake, for the islands (reused buffer, see `contacts::resting_edges`).
+    /// awake, for the islands (reused buffer, filled by the gather; see
+    /// `contacts::push_resting`).
     resting_pairs: Vec<(usize, usize)>,
     /// Time not yet simulated by [`World::step_simulation`].
     accumulator: Real,
