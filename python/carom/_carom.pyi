@@ -490,6 +490,10 @@ class World:
         iterations: int = 10,
         simd: bool = True,
         parallel: bool = True,
+        sleep_linear: float = 0.05,
+        sleep_angular: float = 0.05,
+        sleep_drift: float = 0.015,
+        sleep_time: float = 0.5,
     ) -> World: ...
     def add_body(
         self,

@@ -57,8 +57,29 @@ pub struct BodyInfo {
     pub user_data: u64,
     /// True while the body sleeps.
     pub sleeping: bool,
-    /// Time the body has spent below the sleep velocity thresholds, s.
+    /// Time the body has rested (see [`crate::island::SleepParams`]), s.
     pub sleep_time: Real,
+    /// Centre-of-mass position where the body's current rest began: the drift rule of
+    /// [`crate::island::SleepParams::drift`] measures from it.
+    #[serde(default)]
+    pub rest_position: Vec3,
+    /// Rotation where the body's current rest began (see `rest_position`).
+    #[serde(default)]
+    pub rest_rotation: Quat,
+    /// Radius about the centre of mass of a ball holding the shape (0 without a shape):
+    /// how far a rotation can move a point of the body. Derived from the shape, so not part
+    /// of a snapshot.
+    #[serde(skip)]
+    pub reach: Real,
+}
+
+/// The radius about `com` (body frame) of a ball holding `shape`: the farthest corner of its
+/// local bounding box; 0 without a shape.
+pub(crate) fn reach(shape: Option<&Shape>, com: Vec3) -> Real {
+    shape.map_or(0.0, |s| {
+        let b = s.local_aabb();
+        (b.min - com).abs().max((b.max - com).abs()).length()
+    })
 }
 
 /// All bodies of a world. Hot data is public read-only through accessors; the arrays are
@@ -123,6 +144,9 @@ impl BodySet {
             user_data: desc.user_data,
             sleeping: false,
             sleep_time: 0.0,
+            rest_position: pose.transform_point(m.local_com),
+            rest_rotation: pose.rotation,
+            reach: reach(desc.shape.as_deref(), m.local_com),
         };
         let com = pose.transform_point(m.local_com);
         let index = match self.free.pop() {

@@ -4,14 +4,16 @@
 //! joints (static and kinematic bodies do not join islands, as in Bullet's
 //! `btSimulationIslandManager` and Box2D). An island containing an awake body wakes whole
 //! (a new contact with an awake body, or a user call, wakes a sleeping island); an island
-//! whose bodies all stayed below the velocity thresholds for `time_to_sleep` goes to sleep:
-//! velocities are zeroed and the solver and integrator skip it.
+//! whose bodies all rested for `time_to_sleep` goes to sleep: velocities are zeroed and the
+//! solver and integrator skip it. A body rests while it is slow (Box2D's velocity
+//! thresholds) or while it stays where its rest began (the drift rule of
+//! [`SleepParams::drift`], after Jolt's sleep test spheres).
 
 use crate::body::BodyType;
 use crate::body_set::{BodyHandle, BodySet};
 use crate::contact::ContactManifold;
 use crate::joint::JointSet;
-use carom_collision::math::{check_non_negative, Real, Vec3};
+use carom_collision::math::{check_non_negative, Quat, Real, Vec3};
 use carom_collision::Result;
 use serde::{Deserialize, Serialize};
 
@@ -26,16 +28,26 @@ pub struct SleepParams {
     pub angular_threshold: Real,
     /// Time a whole island must rest before it sleeps, s.
     pub time_to_sleep: Real,
+    /// The drift rule, m: a body with a shape also rests while no point of it has moved
+    /// farther than this from where it was when its rest began, whatever its velocity. A
+    /// body that jitters in place, as contacts settle under a load, then counts as resting;
+    /// one that goes anywhere does not. (The idea of Jolt's sleep test spheres, which keep
+    /// three points of the body within balls of 1.5 cm radius.) 0 leaves only the velocity
+    /// thresholds.
+    pub drift: Real,
 }
 
 impl Default for SleepParams {
-    /// Box2D's thresholds (5 cm/s, 0.5 s) with an angular threshold of ~3°/s.
+    /// Box2D's thresholds (5 cm/s, 0.5 s) with an angular threshold of ~3°/s, and a drift of
+    /// 1.5 cm (Jolt's sphere radius: `PhysicsSettings::mPointVelocitySleepThreshold`, 3 cm/s,
+    /// times `mTimeBeforeSleep`, 0.5 s).
     fn default() -> Self {
         SleepParams {
             enabled: true,
             linear_threshold: 0.05,
             angular_threshold: 0.05,
             time_to_sleep: 0.5,
+            drift: 0.015,
         }
     }
 }
@@ -46,6 +58,7 @@ impl SleepParams {
         check_non_negative("sleep.linear_threshold", self.linear_threshold)?;
         check_non_negative("sleep.angular_threshold", self.angular_threshold)?;
         check_non_negative("sleep.time_to_sleep", self.time_to_sleep)?;
+        check_non_negative("sleep.drift", self.drift)?;
         Ok(())
     }
 }
@@ -289,12 +302,44 @@ fn woken_handles(set: &BodySet, mut slots: Vec<usize>) -> Vec<BodyHandle> {
         .collect()
 }
 
+/// A bound on how far any point of a body moved between two poses of its centre of mass
+/// (`c0`, `q0`) and (`c`, `q`), the points lying within `reach` of the centre. A point `x`
+/// (about the centre) moves by `|Δc + (R - R0) x| <= |Δc| + 2 sin(θ/2) |x|`, `θ` the angle
+/// between the rotations; `2 sin(θ/2)` is bounded by twice the quaternions' chord `|q - q0|`
+/// (`q0`'s sign chosen to match), as in `Separation::holds`, which stays accurate in `f32`
+/// for tiny angles where `q · q0` rounds to 1.
+pub(crate) fn drift_bound(c0: Vec3, q0: Quat, c: Vec3, q: Quat, reach: Real) -> Real {
+    let q0 = if q0.dot(q) < 0.0 { -q0 } else { q0 };
+    (c - c0).length() + 2.0 * (q - q0).length() * reach
+}
+
 /// Advances the rest timer of body slot `i` (awake, dynamic) and returns it.
-fn advance_timer(set: &mut BodySet, i: usize, dt: Real, lin_sq: Real, ang_sq: Real) -> Real {
-    let resting = set.info[i].can_sleep
-        && set.linear_velocity[i].length_squared() <= lin_sq
+///
+/// The body rests while its velocities are under the thresholds, or while no point of it
+/// has moved farther than `drift` ([`drift_bound`]) from the rest anchor, its pose when the
+/// rest began (bodies with a shape only: without one nothing bounds what a rotation moves).
+/// When the drift exceeds `drift` the anchor moves to the current pose, so a slow body
+/// creeping away restarts the drift rule from where it is while its velocity rule goes on
+/// counting, and a moving body takes its anchor with it.
+fn advance_timer(
+    set: &mut BodySet,
+    i: usize,
+    dt: Real,
+    (lin_sq, ang_sq): (Real, Real),
+    drift: Real,
+) -> Real {
+    let (c, q) = (set.position[i], set.rotation[i]);
+    let slow = set.linear_velocity[i].length_squared() <= lin_sq
         && set.angular_velocity[i].length_squared() <= ang_sq;
     let info = &mut set.info[i];
+    let still = drift > 0.0
+        && info.reach > 0.0
+        && drift_bound(info.rest_position, info.rest_rotation, c, q, info.reach) <= drift;
+    if !still {
+        info.rest_position = c;
+        info.rest_rotation = q;
+    }
+    let resting = info.can_sleep && (slow || still);
     info.sleep_time = if resting { info.sleep_time + dt } else { 0.0 };
     info.sleep_time
 }
@@ -313,7 +358,7 @@ pub(crate) fn update_sleep(
     if !params.enabled {
         return Vec::new();
     }
-    let (lin_sq, ang_sq) = (
+    let thresholds = (
         params.linear_threshold * params.linear_threshold,
         params.angular_threshold * params.angular_threshold,
     );
@@ -322,7 +367,7 @@ pub(crate) fn update_sleep(
     if !islands {
         for i in 0..set.capacity() {
             if set.is_awake_dynamic(i) {
-                let t = advance_timer(set, i, dt, lin_sq, ang_sq);
+                let t = advance_timer(set, i, dt, thresholds, params.drift);
                 debug_assert!(t < params.time_to_sleep, "slot {i} rested {t} s");
                 max_rest = max_rest.max(t);
             }
@@ -338,7 +383,7 @@ pub(crate) fn update_sleep(
         if !set.is_awake_dynamic(i) {
             continue;
         }
-        let t = advance_timer(set, i, dt, lin_sq, ang_sq);
+        let t = advance_timer(set, i, dt, thresholds, params.drift);
         min_time[r] = min_time[r].min(t);
     }
     let mut slept = Vec::new();
@@ -359,6 +404,10 @@ pub(crate) fn update_sleep(
     set.max_rest = Some(max_rest);
     slept
 }
+
+#[cfg(test)]
+#[path = "island_drift_tests.rs"]
+mod drift_tests;
 
 #[cfg(test)]
 mod tests {

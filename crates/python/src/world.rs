@@ -38,7 +38,10 @@ fn handle(b: u64) -> BodyHandle {
 /// A rigid-body world. `gravity` (3,) in m/s², `dt` the step of `step()` in seconds,
 /// `method` the broadphase ("tree", the default, "tree_manhattan", "hgrid", "grid",
 /// "sap", "sort_sweep", "brute_force"), `sleeping` whether resting islands fall asleep,
-/// `solver` "soft_step" (Box2D v3's substepping soft step, the default) or "sequential_impulse"
+/// `sleep_linear` (m/s) and `sleep_angular` (rad/s) the speeds under which a body rests,
+/// `sleep_drift` (m) how far a body may move from where its rest began and still rest
+/// whatever its speed (0 turns that rule off), `sleep_time` (s) how long a whole island must
+/// rest before it sleeps, `solver` "soft_step" (Box2D v3's substepping soft step, the default) or "sequential_impulse"
 /// (Bullet's, with split impulses). `substeps` (soft step) and `iterations` (sequential
 /// impulses: velocity and split-impulse iterations) set the solver's effort, each in 1..=1000;
 /// `simd` solves contacts four at a time in SIMD lanes (the same physics as the scalar path);
@@ -74,7 +77,8 @@ impl PyWorld {
     #[new]
     #[pyo3(signature = (
         gravity = None, dt = 1.0 / 60.0, method = "tree", sleeping = true, solver = "soft_step",
-        substeps = 4, iterations = 10, simd = true, parallel = true
+        substeps = 4, iterations = 10, simd = true, parallel = true, sleep_linear = 0.05,
+        sleep_angular = 0.05, sleep_drift = 0.015, sleep_time = 0.5
     ))]
     #[allow(clippy::too_many_arguments)]
     fn new(
@@ -87,12 +91,29 @@ impl PyWorld {
         iterations: i64,
         simd: bool,
         parallel: bool,
+        sleep_linear: f64,
+        sleep_angular: f64,
+        sleep_drift: f64,
+        sleep_time: f64,
     ) -> PyResult<Self> {
         let mut params = PipelineParams::default();
         if let Some(g) = gravity {
             params.dynamics.gravity = vec3(g, "gravity")?;
         }
-        params.dynamics.sleep.enabled = sleeping;
+        let non_negative = |name: &str, x: f64| {
+            let r = scalar(name, x)?;
+            if r >= 0.0 && r.is_finite() {
+                Ok(r)
+            } else {
+                Err(invalid(format!("{name} = {x} must be finite and >= 0")))
+            }
+        };
+        let sleep = &mut params.dynamics.sleep;
+        sleep.enabled = sleeping;
+        sleep.linear_threshold = non_negative("sleep_linear", sleep_linear)?;
+        sleep.angular_threshold = non_negative("sleep_angular", sleep_angular)?;
+        sleep.drift = non_negative("sleep_drift", sleep_drift)?;
+        sleep.time_to_sleep = non_negative("sleep_time", sleep_time)?;
         params.broadphase = core(|| method.parse::<Method>())?;
         params.dynamics.solver.kind = match solver {
             "soft_step" => SolverKind::SoftStep,

@@ -51,10 +51,11 @@ use std::sync::Arc;
 pub const SNAPSHOT_MAGIC: &[u8; 10] = b"CAROMWORLD";
 /// Version of the snapshot format written by [`World::to_bytes`] (2: manifolds keep their
 /// separation certificate, `ContactManifold::apart`; 3: and their GJK simplex,
-/// `ContactManifold::warm`; 4: and which bodies landed in the last step). The payload is
+/// `ContactManifold::warm`; 4: and which bodies landed in the last step; 5: and each body's
+/// rest anchor, `BodyInfo::rest_position` and `rest_rotation`, with the sleep drift). The payload is
 /// postcard, which has no field names, so a snapshot of another version is refused rather
 /// than misread.
-pub const SNAPSHOT_VERSION: u16 = 4;
+pub const SNAPSHOT_VERSION: u16 = 5;
 const HEADER_LEN: usize = 10 + 2 + 1 + 8;
 
 #[derive(Serialize, Deserialize)]
@@ -330,7 +331,9 @@ fn restore(snap: Snapshot) -> Result<World> {
         return Err(corrupt("per-body arrays of different lengths"));
     }
     for (i, s) in snap.body_shapes.iter().enumerate() {
-        bodies.info[i].shape = s.map(shape).transpose()?;
+        let info = &mut bodies.info[i];
+        info.shape = s.map(shape).transpose()?;
+        info.reach = crate::body_set::reach(info.shape.as_deref(), info.local_com);
     }
     world.dynamics = DynamicsWorld::from_parts(params.dynamics, bodies, snap.joints)?;
     world.radius = snap.radius;
