@@ -74,12 +74,18 @@ pub struct BodyInfo {
 }
 
 /// The radius about `com` (body frame) of a ball holding `shape`: the farthest corner of its
-/// local bounding box; 0 without a shape.
+/// local bounding box; 0 without a shape or when that is not finite, which
+/// leaves the body to the velocity rule of sleeping.
 pub(crate) fn reach(shape: Option<&Shape>, com: Vec3) -> Real {
-    shape.map_or(0.0, |s| {
+    let r = shape.map_or(0.0, |s| {
         let b = s.local_aabb();
         (b.min - com).abs().max((b.max - com).abs()).length()
-    })
+    });
+    if r.is_finite() {
+        r
+    } else {
+        0.0
+    }
 }
 
 /// All bodies of a world. Hot data is public read-only through accessors; the arrays are
