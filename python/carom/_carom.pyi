@@ -494,6 +494,7 @@ class World:
         sleep_angular: float = 0.05,
         sleep_drift: float = 0.015,
         sleep_time: float = 0.5,
+        spin_workers: bool = True,
     ) -> World: ...
     def add_body(
         self,

@@ -35,9 +35,12 @@ def _stack(**options: object) -> tuple[carom.World, list[int]]:
 def test_threads_do_not_change_the_result(solver: str) -> None:
     a, ha = _stack(solver=solver, parallel=True)
     b, hb = _stack(solver=solver, parallel=False)
+    c, hc = _stack(solver=solver, parallel=True, spin_workers=False)
     a.step(90)
     b.step(90)
+    c.step(90)
     np.testing.assert_array_equal(a.poses(ha), b.poses(hb))
+    np.testing.assert_array_equal(a.poses(ha), c.poses(hc))
 
 
 def test_simd_and_scalar_contacts_hold_the_same_stack() -> None:

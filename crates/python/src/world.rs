@@ -45,7 +45,9 @@ fn handle(b: u64) -> BodyHandle {
 /// (Bullet's, with split impulses). `substeps` (soft step) and `iterations` (sequential
 /// impulses: velocity and split-impulse iterations) set the solver's effort, each in 1..=1000;
 /// `simd` solves contacts four at a time in SIMD lanes (the same physics as the scalar path);
-/// `parallel` lets a step use rayon's threads (results are bit-identical either way).
+/// `parallel` lets a step use rayon's threads (results are bit-identical either way), and
+/// `spin_workers` keeps those threads awake for the length of each step (they take its
+/// parallel work at once instead of being woken for each loop; the other cores spin meanwhile).
 ///
 /// `add_body(shape, pose, ...)` returns an int handle; `step(n)` advances `n` steps of
 /// `dt`; `poses()` / `velocities()` read every body in one call, `set_poses` /
@@ -78,7 +80,7 @@ impl PyWorld {
     #[pyo3(signature = (
         gravity = None, dt = 1.0 / 60.0, method = "tree", sleeping = true, solver = "soft_step",
         substeps = 4, iterations = 10, simd = true, parallel = true, sleep_linear = 0.05,
-        sleep_angular = 0.05, sleep_drift = 0.015, sleep_time = 0.5
+        sleep_angular = 0.05, sleep_drift = 0.015, sleep_time = 0.5, spin_workers = true
     ))]
     #[allow(clippy::too_many_arguments)]
     fn new(
@@ -95,6 +97,7 @@ impl PyWorld {
         sleep_angular: f64,
         sleep_drift: f64,
         sleep_time: f64,
+        spin_workers: bool,
     ) -> PyResult<Self> {
         let mut params = PipelineParams::default();
         if let Some(g) = gravity {
@@ -136,6 +139,7 @@ impl PyWorld {
         s.position_iterations = s.velocity_iterations;
         s.simd = simd;
         params.dynamics.parallel = parallel;
+        params.spin_workers = spin_workers;
         let dt_r = scalar("dt", dt)?;
         if !(dt_r > 0.0 && dt_r.is_finite()) {
             return Err(invalid(format!("dt must be finite and > 0, got {dt}")));

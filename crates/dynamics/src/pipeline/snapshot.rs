@@ -52,7 +52,8 @@ pub const SNAPSHOT_MAGIC: &[u8; 10] = b"CAROMWORLD";
 /// Version of the snapshot format written by [`World::to_bytes`] (2: manifolds keep their
 /// separation certificate, `ContactManifold::apart`; 3: and their GJK simplex,
 /// `ContactManifold::warm`; 4: and which bodies landed in the last step; 5: and each body's
-/// rest anchor, `BodyInfo::rest_position` and `rest_rotation`, with the sleep drift). The payload is
+/// rest anchor, `BodyInfo::rest_position` and `rest_rotation`, with the sleep drift, and
+/// `PipelineParams::spin_workers`). The payload is
 /// postcard, which has no field names, so a snapshot of another version is refused rather
 /// than misread.
 pub const SNAPSHOT_VERSION: u16 = 5;
@@ -102,6 +103,7 @@ struct Snapshot {
     broadphase: String,
     manifold: ManifoldConfig,
     speculative: bool,
+    spin_workers: bool,
     shapes: Vec<Shape>,
     bodies: BodySet,
     body_shapes: Vec<Option<u32>>,
@@ -217,6 +219,7 @@ impl World {
             broadphase: self.params.broadphase.name().to_string(),
             manifold: self.params.manifold,
             speculative: self.params.speculative,
+            spin_workers: self.params.spin_workers,
             shapes: table.shapes,
             bodies: bodies.clone(),
             body_shapes,
@@ -312,6 +315,7 @@ fn restore(snap: Snapshot) -> Result<World> {
         broadphase: snap.broadphase.parse::<Method>()?,
         manifold: snap.manifold,
         speculative: snap.speculative,
+        spin_workers: snap.spin_workers,
     };
     let mut world = World::new(params)?;
     let shapes: Vec<Arc<Shape>> = snap.shapes.into_iter().map(Arc::new).collect();
