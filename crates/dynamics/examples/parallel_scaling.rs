@@ -13,6 +13,10 @@
 //! stage that streams data out of cache (on the 2-core VM of the bench, about 1.1x against
 //! 1.7x for the compute control).
 //!
+//! A third copy is stepped in the same pool with `PipelineParams::spin_workers` off (the
+//! pool's other threads then sleep between the step's parallel loops), also step by step, so
+//! the line "without spinning workers" compares the two policies under the same conditions.
+//!
 //! `cargo run --release -p carom-dynamics --example parallel_scaling -- [scene 1–8] [steps]
 //! [threads]`
 
@@ -62,6 +66,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         World::from_scene_with(&scene, params)?,
         World::from_scene_with(&scene, params)?,
     ];
+    let mut resting = World::from_scene_with(
+        &scene,
+        PipelineParams {
+            spin_workers: false,
+            ..params
+        },
+    )?;
+    let mut rest_times = vec![];
     // Per side: whole step, solver (+ islands), narrowphase, per step.
     let mut times = [[vec![], vec![], vec![]], [vec![], vec![], vec![]]];
     let mut ratios = vec![];
@@ -71,9 +83,23 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     // Per side: the solver's sub-stages (islands, prepare, forces, warm start, solve,
     // integrate, relax, restitution, store), per step.
     let mut subs: [[Vec<f64>; 9]; 2] = Default::default();
-    for _ in 0..steps {
+    for step in 0..steps {
         let mut wall = [0.0; 2];
-        for side in 0..2 {
+        // The order alternates so that each two-thread copy follows the one-thread step
+        // (its pool idle meanwhile) as often as it follows the other two-thread copy or the
+        // controls: without spinning, one thread, with spinning; then with, one, without.
+        let mut rest_step = |pool: &rayon::ThreadPool| -> Result<(), Box<dyn std::error::Error>> {
+            let t0 = Instant::now();
+            pool.install(|| resting.step(scene.dt))?;
+            rest_times.push(t0.elapsed().as_secs_f64() * 1e3);
+            Ok(())
+        };
+        let even = step % 2 == 0;
+        if even {
+            rest_step(&pools[1])?;
+        }
+        let sides = if even { [0, 1] } else { [1, 0] };
+        for side in sides {
             let w = &mut worlds[side];
             let t0 = Instant::now();
             let (t, d) = pools[side]
@@ -96,6 +122,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             times[side][0].push(wall[side]);
             times[side][1].push((t.solver + t.islands).as_secs_f64() * 1e3);
             times[side][2].push(t.narrowphase.as_secs_f64() * 1e3);
+        }
+        if !even {
+            rest_step(&pools[1])?;
         }
         ratios.push(wall[0] / wall[1]);
         let mut c = [0.0; 2];
@@ -151,8 +180,15 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let b = median(&mut subs[1][k]);
         println!("  {name:<12} {a:.3} vs {b:.3} ms = {:.2}x", a / b);
     }
+    let r = median(&mut rest_times);
+    println!(
+        "  without spinning workers: {r:.3} ms/step = {:.2}x over one thread (with: {:.2}x)",
+        m[0][0] / r,
+        m[0][0] / m[1][0]
+    );
+    let same = same && resting.dynamics().state_hash() == worlds[0].dynamics().state_hash();
     if !same {
-        return Err("the two runs differ".into());
+        return Err("the runs differ".into());
     }
     Ok(())
 }
