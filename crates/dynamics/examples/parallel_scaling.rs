@@ -66,14 +66,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         World::from_scene_with(&scene, params)?,
         World::from_scene_with(&scene, params)?,
     ];
-    let mut resting = World::from_scene_with(
+    let mut no_spin = World::from_scene_with(
         &scene,
         PipelineParams {
             spin_workers: false,
             ..params
         },
     )?;
-    let mut rest_times = vec![];
+    let mut no_spin_times = vec![];
     // Per side: whole step, solver (+ islands), narrowphase, per step.
     let mut times = [[vec![], vec![], vec![]], [vec![], vec![], vec![]]];
     let mut ratios = vec![];
@@ -88,15 +88,16 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         // The order alternates so that each two-thread copy follows the one-thread step
         // (its pool idle meanwhile) as often as it follows the other two-thread copy or the
         // controls: without spinning, one thread, with spinning; then with, one, without.
-        let mut rest_step = |pool: &rayon::ThreadPool| -> Result<(), Box<dyn std::error::Error>> {
-            let t0 = Instant::now();
-            pool.install(|| resting.step(scene.dt))?;
-            rest_times.push(t0.elapsed().as_secs_f64() * 1e3);
-            Ok(())
-        };
+        let mut no_spin_step =
+            |pool: &rayon::ThreadPool| -> Result<(), Box<dyn std::error::Error>> {
+                let t0 = Instant::now();
+                pool.install(|| no_spin.step(scene.dt))?;
+                no_spin_times.push(t0.elapsed().as_secs_f64() * 1e3);
+                Ok(())
+            };
         let even = step % 2 == 0;
         if even {
-            rest_step(&pools[1])?;
+            no_spin_step(&pools[1])?;
         }
         let sides = if even { [0, 1] } else { [1, 0] };
         for side in sides {
@@ -124,7 +125,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             times[side][2].push(t.narrowphase.as_secs_f64() * 1e3);
         }
         if !even {
-            rest_step(&pools[1])?;
+            no_spin_step(&pools[1])?;
         }
         ratios.push(wall[0] / wall[1]);
         let mut c = [0.0; 2];
@@ -180,13 +181,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let b = median(&mut subs[1][k]);
         println!("  {name:<12} {a:.3} vs {b:.3} ms = {:.2}x", a / b);
     }
-    let r = median(&mut rest_times);
+    let r = median(&mut no_spin_times);
     println!(
         "  without spinning workers: {r:.3} ms/step = {:.2}x over one thread (with: {:.2}x)",
         m[0][0] / r,
         m[0][0] / m[1][0]
     );
-    let same = same && resting.dynamics().state_hash() == worlds[0].dynamics().state_hash();
+    let same = same && no_spin.dynamics().state_hash() == worlds[0].dynamics().state_hash();
     if !same {
         return Err("the runs differ".into());
     }

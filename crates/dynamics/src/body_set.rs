@@ -133,6 +133,7 @@ impl BodySet {
     /// Validates `desc` and adds the body.
     pub fn insert(&mut self, desc: &BodyDesc) -> Result<BodyHandle> {
         let (pose, m) = desc.validate()?;
+        let com = pose.transform_point(m.local_com);
         let info = BodyInfo {
             body_type: desc.body_type,
             shape: desc.shape.clone(),
@@ -150,11 +151,10 @@ impl BodySet {
             user_data: desc.user_data,
             sleeping: false,
             sleep_time: 0.0,
-            rest_position: pose.transform_point(m.local_com),
+            rest_position: com,
             rest_rotation: pose.rotation,
             reach: reach(desc.shape.as_deref(), m.local_com),
         };
-        let com = pose.transform_point(m.local_com);
         let index = match self.free.pop() {
             Some(i) => i as usize,
             None => {

@@ -13,7 +13,7 @@ use crate::body::BodyType;
 use crate::body_set::{BodyHandle, BodySet};
 use crate::contact::ContactManifold;
 use crate::joint::JointSet;
-use carom_collision::math::{check_non_negative, Quat, Real, Vec3};
+use carom_collision::math::{check_non_negative, motion_bound, Real, Vec3};
 use carom_collision::Result;
 use serde::{Deserialize, Serialize};
 
@@ -302,21 +302,11 @@ fn woken_handles(set: &BodySet, mut slots: Vec<usize>) -> Vec<BodyHandle> {
         .collect()
 }
 
-/// A bound on how far any point of a body moved between two poses of its centre of mass
-/// (`c0`, `q0`) and (`c`, `q`), the points lying within `reach` of the centre. A point `x`
-/// (about the centre) moves by `|Δc + (R - R0) x| <= |Δc| + 2 sin(θ/2) |x|`, `θ` the angle
-/// between the rotations; `2 sin(θ/2)` is bounded by twice the quaternions' chord `|q - q0|`
-/// (`q0`'s sign chosen to match), as in `Separation::holds`, which stays accurate in `f32`
-/// for tiny angles where `q · q0` rounds to 1.
-pub(crate) fn drift_bound(c0: Vec3, q0: Quat, c: Vec3, q: Quat, reach: Real) -> Real {
-    let q0 = if q0.dot(q) < 0.0 { -q0 } else { q0 };
-    (c - c0).length() + 2.0 * (q - q0).length() * reach
-}
-
 /// Advances the rest timer of body slot `i` (awake, dynamic) and returns it.
 ///
 /// The body rests while its velocities are under the thresholds, or while no point of it
-/// has moved farther than `drift` ([`drift_bound`]) from the rest anchor, its pose when the
+/// has moved farther than `drift` ([`motion_bound`], the shape's reach about the centre of
+/// mass) from the rest anchor, its pose when the
 /// rest began (bodies with a shape only: without one nothing bounds what a rotation moves).
 /// When the drift exceeds `drift` the anchor moves to the current pose, so a slow body
 /// creeping away restarts the drift rule from where it is while its velocity rule goes on
@@ -334,7 +324,7 @@ fn advance_timer(
     let info = &mut set.info[i];
     let still = drift > 0.0
         && info.reach > 0.0
-        && drift_bound(info.rest_position, info.rest_rotation, c, q, info.reach) <= drift;
+        && motion_bound(info.rest_position, info.rest_rotation, c, q, info.reach) <= drift;
     if !still {
         info.rest_position = c;
         info.rest_rotation = q;

@@ -2,9 +2,10 @@
 //! bound against every vertex of a hull, then the rest timers of one body driven through
 //! jitter, travel, spin and creep.
 
-use super::{drift_bound, update_sleep, IslandScratch, SleepParams};
+use super::{update_sleep, IslandScratch, SleepParams};
 use crate::body::MassSpec;
 use crate::body_set::reach;
+use crate::collision::math::motion_bound;
 use crate::collision::math::{Isometry, Mat3, Quat, Real, Vec3};
 use crate::collision::shape::{ConvexHull, Cuboid, MassProperties, Shape};
 use crate::{BodyDesc, BodySet};
@@ -35,10 +36,10 @@ proptest! {
 
     /// For random hulls (their centres of mass off the shape origin) and pose changes (pure
     /// translations; tiny, small and large rotations; near and 1 km from the origin; the
-    /// quaternion's sign flipped), no vertex moved farther than [`drift_bound`] says, within
+    /// quaternion's sign flipped), no vertex moved farther than [`motion_bound`] says, within
     /// the rounding of the world points themselves; a pure translation's bound is its length.
     #[test]
-    fn drift_bound_covers_every_point(
+    fn motion_bound_covers_every_point(
         offset in point(2.0),
         points in prop::collection::vec(point(1.0), 8..16),
         c0 in point(5.0),
@@ -61,7 +62,7 @@ proptest! {
         let turn = Quat::from_axis_angle(turn_axis * Vec3::X, angle);
         let dc = dc * dc_scale;
         let (c, q) = (c0 + dc, (turn * q0).normalize());
-        let bound = drift_bound(c0, q0, c, if flip { -q } else { q }, r);
+        let bound = motion_bound(c0, q0, c, if flip { -q } else { q }, r);
         let moved = hull
             .vertices()
             .iter()

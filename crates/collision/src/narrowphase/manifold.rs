@@ -95,13 +95,13 @@ impl Separation {
     /// `prediction` apart (see the type's docs). False for non-finite values.
     pub fn holds(&self, pose_ab: &Isometry, prediction: Real) -> bool {
         let p0 = &self.pose_ab;
-        // For unit quaternions at an angle θ, |q - q0| = 2 sin(θ/4) (q0's sign chosen to
-        // match), so 2 sin(θ/2) = 4 sin(θ/4) cos(θ/4) <= 2 |q - q0|. Not sqrt(1 - (q·q0)²):
-        // in f32, q·q0 rounds to 1 for angles under about 5e-4 rad.
-        let (q0, q) = (p0.rotation, pose_ab.rotation);
-        let q0 = if q0.dot(q) < 0.0 { -q0 } else { q0 };
-        let chord = (q - q0).length();
-        let moved = (pose_ab.translation - p0.translation).length() + 2.0 * chord * self.reach;
+        let moved = crate::math::motion_bound(
+            p0.translation,
+            p0.rotation,
+            pose_ab.translation,
+            pose_ab.rotation,
+            self.reach,
+        );
         // Round-off of the separation, measured at p0: relative to the sizes involved.
         let slack = 1.0e-5 * (p0.translation.length() + self.reach);
         self.distance - moved - slack > prediction
