@@ -280,3 +280,49 @@ def test_shape_cast_batch_equals_single() -> None:
             assert batch.toi[i] == one.toi
             np.testing.assert_array_equal(batch.normal[i], one.normal)
     assert n_hit > 0
+
+
+def _random_quat(rng: np.random.Generator) -> np.ndarray:
+    q = rng.normal(size=4)
+    return q / np.linalg.norm(q)
+
+
+@pytest.mark.parametrize("scale", [1e-4, 1e-3, 1e3])
+def test_distance_does_not_depend_on_the_unit_of_length(scale: float) -> None:
+    """A configuration scaled by `scale` gives `scale` times the distance of the same one at
+    1 m, both argument orders, for curved shapes, polytopes and a triangle, apart and
+    overlapping. Sub-millimetre pairs were wrong before session 26: capsule-box distances
+    23 % short (an absolute touching test) and cone-triangle depths 13 % deep (EPA's sliver
+    test)."""
+    rng = np.random.default_rng(26)
+    pts = rng.normal(size=(10, 3)) * 0.4
+
+    def shapes(s: float) -> list[carom.Shape]:
+        return [
+            carom.Capsule(0.2 * s, 0.5 * s),
+            carom.Box([0.5 * s, 0.2 * s, 0.3 * s]),
+            carom.Cone(0.3 * s, 0.4 * s),
+            carom.Cylinder(0.3 * s, 0.4 * s),
+            carom.ConvexHull(pts * s),
+            carom.Triangle([0, 0, 0], [s, 0, 0], [0, s, 0]),
+        ]
+
+    unit, scaled = shapes(1.0), shapes(scale)
+    checked = 0
+    for i in range(len(unit)):
+        for j in range(len(unit)):
+            for _ in range(8):
+                pa = (rng.normal(size=3) * 0.5, _random_quat(rng))
+                pb = (pa[0] + rng.normal(size=3) * 0.8, _random_quat(rng))
+                want = carom.distance(unit[i], pose(*pa), unit[j], pose(*pb)).distance
+                a_pose = pose(pa[0] * scale, pa[1])
+                b_pose = pose(pb[0] * scale, pb[1])
+                d1 = carom.distance(scaled[i], a_pose, scaled[j], b_pose)
+                d2 = carom.distance(scaled[j], b_pose, scaled[i], a_pose)
+                for d in (d1.distance, d2.distance):
+                    assert d / scale == pytest.approx(want, abs=1e-3), (i, j, scale)
+                if want > 1e-3:
+                    gap = np.linalg.norm(np.asarray(d1.point_a) - np.asarray(d1.point_b))
+                    assert gap / scale == pytest.approx(want, abs=1e-3)
+                checked += 1
+    assert checked == 6 * 6 * 8

@@ -109,15 +109,16 @@ fn make_face(verts: &[Vertex], idx: [u32; 3], tol: Real) -> Option<Face> {
     );
     let n = (q - p).cross(r - p);
     let len = n.length();
-    // One square root of the largest squared edge length: `sqrt` is correctly rounded and
-    // monotone, so `sqrt(max(a, b, c)) == max(sqrt a, sqrt b, sqrt c)` bit for bit (and
-    // `max` skips a NaN the same way on either side), two square roots fewer per face.
-    let edge = (q - p)
+    // A sliver: its height over the longest edge (`len / edge`) at most `tol` times that
+    // edge. Relative, so that the test means the same at every scale: an absolute height
+    // (`len <= tol * edge`, as before) dropped the faces of millimetre shapes whose height
+    // was under 8 µm, EPA then stopped at a coarse face, and a 0.1 mm cone's depth against
+    // a triangle came out 13 % deep in one argument order (`epa_is_scale_invariant`).
+    let edge_sq = (q - p)
         .length_squared()
         .max((r - p).length_squared())
-        .max((r - q).length_squared())
-        .sqrt();
-    if len.is_nan() || len <= tol * edge {
+        .max((r - q).length_squared());
+    if len.is_nan() || len <= tol * edge_sq {
         return None;
     }
     let normal = n / len;
