@@ -76,6 +76,11 @@ python-test: develop
 	$(PY) -m mypy.stubtest carom._carom
 
 test: CAROM_PROFILE = ci
+# One seed for the property tests that do not fix their own, so that `make test` (and CI)
+# runs the same cases on every machine: with a fresh seed per run, a test that mishandled a
+# rare case could fail a clean clone at random (session 26 found one). Plain `cargo test`
+# still draws fresh seeds; override with `make test PROPTEST_RNG_SEED=<n>`.
+test: export PROPTEST_RNG_SEED ?= 2611
 test: fmt-check lint rust-test rust-test-f64 rust-test-serial rust-test-release python-test
 	@echo "make test: all checks passed"
 
