@@ -101,12 +101,7 @@ fn lowest_f64(points: &[Vec3], pose: &Isometry) -> f64 {
 
 /// A fixed seed and no persisted failures: CI runs the same 256 cases on every machine.
 fn fixed(cases: u32) -> ProptestConfig {
-    ProptestConfig {
-        cases,
-        rng_seed: proptest::test_runner::RngSeed::Fixed(0x6361_726f_6d07),
-        failure_persistence: None,
-        ..ProptestConfig::default()
-    }
+    common::fixed_config(cases, 0x6361_726f_6d07)
 }
 
 proptest! {

@@ -8,6 +8,9 @@
 //! Oracle: the same query at `s = 1`, and the pair swapped (exact relations: the distance is
 //! symmetric, the normal reverses).
 
+#[path = "query_common/mod.rs"]
+mod common;
+
 use carom_collision::math::{Isometry, Quat, Real, Vec3};
 use carom_collision::query::{contact, distance};
 use carom_collision::shape::{
@@ -53,12 +56,7 @@ fn unit_quat(q: [Real; 4]) -> Quat {
 
 /// A fixed seed and no persisted failures: CI runs the same cases on every machine.
 fn fixed(cases: u32) -> ProptestConfig {
-    ProptestConfig {
-        cases,
-        rng_seed: proptest::test_runner::RngSeed::Fixed(0x7363_616c_6526),
-        failure_persistence: None,
-        ..ProptestConfig::default()
-    }
+    common::fixed_config(cases, 0x7363_616c_6526)
 }
 
 /// The session-26 case: a 0.1 mm and a 1 mm cone against a triangle, both argument orders,

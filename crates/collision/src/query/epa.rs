@@ -113,7 +113,7 @@ fn make_face(verts: &[Vertex], idx: [u32; 3], tol: Real) -> Option<Face> {
     // edge. Relative, so that the test means the same at every scale: an absolute height
     // (`len <= tol * edge`, as before) dropped the faces of millimetre shapes whose height
     // was under 8 µm, EPA then stopped at a coarse face, and a 0.1 mm cone's depth against
-    // a triangle came out 13 % deep in one argument order (`epa_is_scale_invariant`).
+    // a triangle came out 13 % deep in one argument order (`tests/query_scale.rs`).
     let edge_sq = (q - p)
         .length_squared()
         .max((r - p).length_squared())

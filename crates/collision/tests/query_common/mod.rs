@@ -8,6 +8,17 @@ use carom_collision::query::closest_points::{
 };
 use carom_collision::shape::ConvexHull;
 
+/// A property-test configuration with a fixed seed and no persisted failures, so CI runs the
+/// same `cases` on every machine.
+pub fn fixed_config(cases: u32, seed: u64) -> proptest::test_runner::Config {
+    proptest::test_runner::Config {
+        cases,
+        rng_seed: proptest::test_runner::RngSeed::Fixed(seed),
+        failure_persistence: None,
+        ..proptest::test_runner::Config::default()
+    }
+}
+
 /// Tolerance in length units, scaled to the precision of `Real`.
 pub fn tol() -> Real {
     if std::mem::size_of::<Real>() == 8 {
