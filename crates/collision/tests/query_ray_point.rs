@@ -495,3 +495,77 @@ fn unrotated_poses_take_the_translation_path_with_the_same_hits() {
     }
     assert!(hits > cases / 3, "{hits} of {cases}");
 }
+
+/// Entry of the ray into the cone (apex at `+h`, base radius `r` at `-h`), solved in f64.
+fn cone_entry_f64(r: f64, h: f64, o: [f64; 3], d: [f64; 3]) -> f64 {
+    let n = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+    let d = d.map(|c| c / n);
+    let k2 = (r / (2.0 * h)).powi(2);
+    let a = d[0] * d[0] + d[2] * d[2] - k2 * d[1] * d[1];
+    let b = 2.0 * (o[0] * d[0] + o[2] * d[2] + k2 * (h - o[1]) * d[1]);
+    let c = o[0] * o[0] + o[2] * o[2] - k2 * (h - o[1]) * (h - o[1]);
+    let s = (b * b - 4.0 * a * c).sqrt();
+    let mut roots = [(-b - s) / (2.0 * a), (-b + s) / (2.0 * a)];
+    roots.sort_by(f64::total_cmp);
+    let inside = |t: f64| {
+        let p = [o[0] + d[0] * t, o[1] + d[1] * t, o[2] + d[2] * t];
+        p[1].abs() <= h * (1.0 + 1e-9) && p[0].hypot(p[2]) <= (r / (2.0 * h)) * (h - p[1]) + 1e-9
+    };
+    *roots
+        .iter()
+        .find(|&&t| inside(t))
+        .expect("the ray enters the side")
+}
+
+/// Session 27's sweep: rays from ~10 cone sizes away, one nearly along a generator, were
+/// 5e-3 and 0.1 off in f32 (cancellation in the quadric's coefficients for a far origin).
+#[test]
+fn cone_rays_from_afar_and_along_a_generator() {
+    for (r, h, o, d) in [
+        (
+            1.0,
+            1.0,
+            [-4.506_383_78, 11.421_577_18, 2.840_225_3],
+            [0.378_759_63, -0.894_462_47, -0.237_651_09],
+        ),
+        (
+            1.0,
+            0.01,
+            [
+                -4.793_589_115_142_822,
+                8.566_519_737_243_652,
+                -1.906_894_803_047_180_2,
+            ],
+            [
+                0.491_955_637_931_823_73,
+                -0.853_220_224_380_493_2,
+                0.173_190_310_597_419_74,
+            ],
+        ),
+    ] {
+        let cone = Shape::Cone(Cone::new(r as Real, h as Real).unwrap());
+        let v = |a: [f64; 3]| Vec3::new(a[0] as Real, a[1] as Real, a[2] as Real);
+        let hit = raycast(&cone, &Isometry::IDENTITY, v(o), v(d), 100.0, true)
+            .unwrap()
+            .expect("a hit");
+        // The oracle from the f32-rounded inputs, in f64.
+        let (o, d) = (
+            v(o).to_array().map(f64::from),
+            v(d).to_array().map(f64::from),
+        );
+        let want = cone_entry_f64(r, h, o, d);
+        // Along a generator the entry is ill-conditioned (a rounding of the direction moves
+        // it far along the ray): the distance within 1e-4 of it, the point on the surface.
+        assert!(
+            (hit.distance as f64 - want).abs() < 1e-4 * want,
+            "cone r {r} h {h}: {} vs {want}",
+            hit.distance
+        );
+        let on = project_point(&cone, &Isometry::IDENTITY, hit.point).unwrap();
+        assert!(
+            on.distance.abs() < 2e-5,
+            "hit point {} off the cone",
+            on.distance
+        );
+    }
+}
