@@ -67,6 +67,10 @@ pub fn closest_points_segment_segment(p1: Vec3, q1: Vec3, p2: Vec3, q2: Vec3) ->
 pub fn closest_point_triangle(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> Vec3 {
     let ab = b - a;
     let ac = c - a;
+    if a == b || a == c || b == c {
+        // A repeated corner: the edge regions below would divide 0 by 0.
+        return closest_point_on_edges(p, a, b, c);
+    }
     let ap = p - a;
     let d1 = ab.dot(ap);
     let d2 = ac.dot(ap);
@@ -103,24 +107,30 @@ pub fn closest_point_triangle(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> Vec3 {
     let sum = va + vb + vc;
     if sum == 0.0 || !sum.is_finite() {
         // Degenerate (zero-area) triangle: best of the edges.
-        let cands = [
-            closest_point_segment(p, a, b).0,
-            closest_point_segment(p, b, c).0,
-            closest_point_segment(p, a, c).0,
-        ];
-        return cands
-            .into_iter()
-            .min_by(|x, y| {
-                (*x - p)
-                    .length_squared()
-                    .total_cmp(&(*y - p).length_squared())
-            })
-            .expect("three candidates");
+        return closest_point_on_edges(p, a, b, c);
     }
     let denom = 1.0 / sum;
     let v = vb * denom;
     let w = vc * denom;
     a + ab * v + ac * w
+}
+
+/// The closest point to `p` on the edges of the triangle `(a, b, c)`: the answer for a
+/// triangle without area (a segment or a point).
+fn closest_point_on_edges(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> Vec3 {
+    let cands = [
+        closest_point_segment(p, a, b).0,
+        closest_point_segment(p, b, c).0,
+        closest_point_segment(p, a, c).0,
+    ];
+    cands
+        .into_iter()
+        .min_by(|x, y| {
+            (*x - p)
+                .length_squared()
+                .total_cmp(&(*y - p).length_squared())
+        })
+        .expect("three candidates")
 }
 
 #[cfg(test)]
@@ -186,5 +196,20 @@ mod tests {
         // Degenerate triangle.
         let q = closest_point_triangle(Vec3::Y, Vec3::ZERO, Vec3::X, Vec3::X * 2.0);
         assert!(q.is_finite() && (q - Vec3::ZERO).length() < 1e-6);
+        // Repeated corners (a segment, a point): every order of the corners, and points in
+        // every region (session 27: `a == b` divided 0 by 0 and returned NaN).
+        let (s, t) = (Vec3::new(1.0, 0.0, 0.0), Vec3::new(3.0, 0.0, 0.0));
+        for p in [
+            Vec3::new(0.0, 1.0, 0.0),
+            Vec3::new(2.0, 1.0, 0.5),
+            Vec3::new(4.0, -1.0, 0.0),
+        ] {
+            let want = closest_point_segment(p, s, t).0;
+            for (a, b, c) in [(s, s, t), (s, t, s), (t, s, s), (s, t, t)] {
+                let q = closest_point_triangle(p, a, b, c);
+                assert!((q - want).length() < 1e-6, "{p} on {a} {b} {c}: {q}");
+            }
+            assert_eq!(closest_point_triangle(p, s, s, s), s);
+        }
     }
 }

@@ -136,7 +136,14 @@ pub fn fallback_contact(
         let best = out
             .into_iter()
             .map(|(k, _)| k)
-            .filter(|k| k.distance.is_finite() && k.normal.is_finite())
+            // A triangle without area has a zero face normal, which the separating-axis
+            // test may pick as a face (at separation 0); such answers are dropped for the
+            // sampled directions below.
+            .filter(|k| {
+                k.distance.is_finite()
+                    && k.normal.is_finite()
+                    && (k.normal.length() - 1.0).abs() <= 1.0e-3
+            })
             .min_by(|x, y| x.distance.total_cmp(&y.distance));
         if best.is_some() {
             return best;
