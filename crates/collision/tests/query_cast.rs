@@ -272,3 +272,69 @@ fn extreme_values_stay_finite_and_terminate() {
         }
     }
 }
+
+/// Session 27's sweep: conservative advancement ran out of iterations on shapes that never
+/// come close, and reported the last safe time as a hit. A sphere's spin now counts for
+/// nothing, and pieces whose bounding balls cannot meet in the rest of the motion stop.
+/// A rotating plane, which the method cannot bound, is refused.
+#[test]
+fn spinning_shapes_that_pass_each_other_report_no_hit() {
+    let ball = Shape::Sphere(Sphere::new(0.5).unwrap());
+    let still = Motion::new(Isometry::IDENTITY, Vec3::ZERO, Vec3::ZERO).unwrap();
+    let spinning = Motion::new(
+        Isometry::from_translation(Vec3::new(-1.0, 1.3, 0.0)),
+        Vec3::new(0.2, 0.0, 0.0),
+        Vec3::new(0.0, 0.0, 100.0),
+    )
+    .unwrap();
+    assert_eq!(
+        time_of_impact(&ball, &still, &ball, &spinning, 2.0, 1e-4).unwrap(),
+        None
+    );
+    // A spinning box passing a sphere, over a very long time.
+    let cube = Shape::Cuboid(Cuboid::new(Vec3::splat(0.5)).unwrap());
+    let passing = Motion::new(
+        Isometry::from_translation(Vec3::new(-3.0, 2.0, 0.0)),
+        Vec3::new(0.5, 0.0, 0.0),
+        Vec3::new(0.3, 1.0, 0.0),
+    )
+    .unwrap();
+    assert_eq!(
+        time_of_impact(&ball, &still, &cube, &passing, 1e30, 1e-4).unwrap(),
+        None
+    );
+    // The same box aimed at the sphere is still hit (first contact by sampling: 4.7).
+    let aimed = Motion::new(passing.pose, Vec3::new(0.5, -0.4, 0.0), passing.angvel).unwrap();
+    let h = time_of_impact(&ball, &still, &cube, &aimed, 1e30, 1e-4)
+        .unwrap()
+        .expect("a hit");
+    let d = |t: Real| {
+        distance(&ball, &Isometry::IDENTITY, &cube, &aimed.pose_at(t))
+            .unwrap()
+            .distance
+    };
+    let first = (0..=10_000)
+        .map(|k| k as Real * 1e-3)
+        .find(|&t| d(t) <= 0.0)
+        .expect("the box reaches the sphere");
+    assert!(
+        h.toi <= first && d(h.toi) <= 1e-4 * 1.01,
+        "{} vs {first}",
+        h.toi
+    );
+    // A rotating plane is refused; a translating one is fine.
+    let plane = Shape::Plane(carom_collision::shape::Plane::new(Vec3::Y, 0.0).unwrap());
+    let turning = Motion::new(Isometry::IDENTITY, Vec3::ZERO, Vec3::Z * 2.0).unwrap();
+    let box_at = Motion::new(
+        Isometry::from_translation(Vec3::new(5.0, 1.0, 0.0)),
+        Vec3::ZERO,
+        Vec3::ZERO,
+    )
+    .unwrap();
+    assert!(time_of_impact(&plane, &turning, &cube, &box_at, 1.0, 1e-4).is_err());
+    let rising = Motion::new(Isometry::IDENTITY, Vec3::Y, Vec3::ZERO).unwrap();
+    let h = time_of_impact(&plane, &rising, &cube, &box_at, 1.0, 1e-4)
+        .unwrap()
+        .expect("the rising plane reaches the box");
+    assert!((h.toi - 0.5).abs() < 1e-3, "{}", h.toi);
+}

@@ -5,7 +5,7 @@
 
 use super::mesh_query::{brute_force_closest, MeshPointProjection, MeshRayHit};
 use super::triangle_query::WatertightRay;
-use crate::math::{Real, Vec3};
+use crate::math::{Aabb, Real, Vec3};
 use crate::shape::{HeightField, Shape, TriMesh};
 
 /// A shape made of triangles, queried through its own acceleration structure.
@@ -40,6 +40,23 @@ impl<'a> TriangleSource<'a> {
         match self {
             TriangleSource::Mesh(m) => m.triangle(i as usize),
             TriangleSource::HeightField(h) => h.triangle(i as usize),
+        }
+    }
+
+    /// Calls `f(triangle)` for every triangle whose bounding box overlaps `aabb` (touching
+    /// counts), in no particular order; `f` returns `false` to stop.
+    pub fn for_each_triangle_in_aabb(&self, aabb: &Aabb, f: impl FnMut(u32) -> bool) {
+        match self {
+            TriangleSource::Mesh(m) => m.view().for_each_triangle_in_aabb(aabb, f),
+            TriangleSource::HeightField(h) => h.for_each_triangle_in_aabb(aabb, f),
+        }
+    }
+
+    /// Bounding box of every triangle.
+    pub fn local_aabb(&self) -> Aabb {
+        match self {
+            TriangleSource::Mesh(m) => m.local_aabb(),
+            TriangleSource::HeightField(h) => h.local_aabb(),
         }
     }
 

@@ -3,16 +3,18 @@
 //! These validate their input (poses must be finite with unit quaternions, within
 //! [`crate::math::UNIT_QUAT_TOLERANCE`]; the prediction distance must not be NaN) and
 //! return [`crate::Result`]. They handle every [`Shape`]: convex pairs through
-//! [`contact_convex`], planes exactly through the other shape's support point, and meshes
-//! and compounds by recursion over their triangles and children (brute force here; the
-//! midphase BVH accelerates this in the narrowphase). Plane–plane and plane–mesh pairs are
-//! [`CaromError::Unsupported`].
+//! [`contact_convex`], planes exactly through the other shape's support point, compounds by
+//! recursion over their children, and meshes and heightfields over the triangles their BVH
+//! or grid finds near the other shape (module `query::composite`). Plane–plane,
+//! plane–mesh and plane–heightfield pairs are [`CaromError::Unsupported`].
 
+use super::composite::contact_triangles;
 use super::contact_convex::{contact_convex, intersects_convex, swap_contact};
 use super::result::Contact;
 use crate::error::{CaromError, Result};
 use crate::math::{Isometry, Real};
-use crate::shape::{ConvexRef, Plane, Shape, SupportMap, Triangle};
+use crate::midphase::TriangleSource;
+use crate::shape::{ConvexRef, Plane, Shape, SupportMap};
 
 /// Contact between `a` at `pose_a` and `b` at `pose_b` (world frame): `None` when they are
 /// further apart than `prediction` (>= 0, may be infinite), else the signed distance,
@@ -67,12 +69,14 @@ pub fn contact_local(
         return Ok(contact_convex(ca, cb, pose_ab, prediction));
     }
     match (a, b) {
-        (Shape::Plane(_), Shape::Plane(_) | Shape::TriMesh(_))
-        | (Shape::TriMesh(_), Shape::Plane(_)) => Err(CaromError::Unsupported(format!(
-            "contact between a {} and a {}",
-            a.kind_name(),
-            b.kind_name()
-        ))),
+        (Shape::Plane(_), Shape::Plane(_) | Shape::TriMesh(_) | Shape::HeightField(_))
+        | (Shape::TriMesh(_) | Shape::HeightField(_), Shape::Plane(_)) => {
+            Err(CaromError::Unsupported(format!(
+                "contact between a {} and a {}",
+                a.kind_name(),
+                b.kind_name()
+            )))
+        }
         (Shape::Plane(p), _) if b.is_convex() => Ok(contact_plane_convex(
             p,
             b.as_convex().expect("checked"),
@@ -104,25 +108,11 @@ pub fn contact_local(
                     .map(|c| c.swapped().transformed(pose_ab)),
             )
         }
-        (Shape::TriMesh(m), _) => {
-            let mut best: Option<Contact> = None;
-            for i in 0..m.num_triangles() {
-                let [ta, tb, tc] = m.triangle(i);
-                let tri = Triangle {
-                    a: ta,
-                    b: tb,
-                    c: tc,
-                };
-                let k = contact_local(&Shape::Triangle(tri), b, pose_ab, prediction)?;
-                if let Some(k) = k {
-                    if best.is_none_or(|bk| k.distance < bk.distance) {
-                        best = Some(k);
-                    }
-                }
-            }
-            Ok(best)
+        (Shape::TriMesh(_) | Shape::HeightField(_), _) => {
+            let src = TriangleSource::of(a).expect("a mesh or heightfield");
+            contact_triangles(src, b, pose_ab, prediction)
         }
-        (_, Shape::TriMesh(_)) => {
+        (_, Shape::TriMesh(_) | Shape::HeightField(_)) => {
             let pose_ba = pose_ab.inverse();
             Ok(
                 contact_local(b, a, &pose_ba, prediction)?

@@ -42,6 +42,7 @@ pub mod contact_cuboid_cuboid;
 pub mod contact_round;
 
 pub use contact_convex::{contact_convex, distance_convex, intersects_convex};
+pub(crate) mod composite;
 pub mod contact;
 pub use contact::{contact, contact_local, distance, intersects};
 pub mod ray;

@@ -3,18 +3,21 @@
 //! spheres and capsules are swept exactly. B moves relative to A by `v_b - v_a`; the cast
 //! finds the first time the shapes touch.
 
+use super::composite::shape_cast_triangles;
 use super::contact_convex::contact_convex;
 use super::ray::gjk_ray::gjk_raycast;
 use super::result::{Contact, ShapeCastHit};
 use super::support_adapters::{core_radius, Core, MinkowskiDiff, Transformed};
 use crate::error::{CaromError, Result};
 use crate::math::{check_finite_vec, Isometry, Real, Vec3};
-use crate::shape::{ConvexRef, Shape, Triangle};
+use crate::midphase::TriangleSource;
+use crate::shape::{ConvexRef, Shape};
 
 /// Casts `a` (at `pose_a`, moving by `vel_a` per unit time) and `b` (at `pose_b`, moving by
 /// `vel_b`) until they touch, for times in `[0, max_toi]`. Returns the first time of contact
 /// with the witness points and normal at that time (world space), or `None`. Convex shapes,
-/// meshes and compounds (by recursion) are supported; planes are not.
+/// compounds (by recursion), meshes and heightfields (over the triangles B's swept box meets)
+/// are supported; planes are not.
 pub fn shape_cast(
     a: &Shape,
     pose_a: &Isometry,
@@ -87,19 +90,13 @@ pub fn shape_cast_local(
                 );
             }
         }
-        (Shape::TriMesh(m), _) => {
-            for i in 0..m.num_triangles() {
-                let [ta, tb, tc] = m.triangle(i);
-                let tri = Shape::Triangle(Triangle {
-                    a: ta,
-                    b: tb,
-                    c: tc,
-                });
-                keep(shape_cast_local(&tri, b, pose_ab, rel_vel, max_toi)?);
-            }
+        (Shape::TriMesh(_) | Shape::HeightField(_), _) => {
+            let src = TriangleSource::of(a).expect("a mesh or heightfield");
+            keep(shape_cast_triangles(src, b, pose_ab, rel_vel, max_toi)?);
         }
-        _ => {
-            // B is the mesh or compound: swap roles (A moves by -rel_vel relative to B).
+        (_, Shape::Compound(_) | Shape::TriMesh(_) | Shape::HeightField(_)) => {
+            // B is the compound, mesh or heightfield: swap roles (A moves by -rel_vel
+            // relative to B).
             let pose_ba = pose_ab.inverse();
             let rel = pose_ba.transform_vector(-rel_vel);
             keep(shape_cast_local(b, a, &pose_ba, rel, max_toi)?.map(|h| {
@@ -113,6 +110,15 @@ pub fn shape_cast_local(
                     ..h
                 }
             }));
+        }
+        // Every other pair is convex (handled above); kept so that a new shape kind
+        // cannot recurse through the swap forever.
+        _ => {
+            return Err(CaromError::Unsupported(format!(
+                "shape cast between a {} and a {}",
+                a.kind_name(),
+                b.kind_name()
+            )))
         }
     }
     Ok(best)
