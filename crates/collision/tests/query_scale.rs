@@ -182,3 +182,27 @@ proptest! {
         }
     }
 }
+
+/// Far from the origin (coordinates of 1e5, an f32 spacing of 8 mm) a near-touching pair's
+/// witnesses can coincide after rounding: the normal stays unit (GJK's own direction), not
+/// zero (session 27's sweep: a triangle against a cylinder, both around 1e5).
+#[test]
+fn normals_stay_unit_far_from_the_origin() {
+    let tri = Shape::Triangle(Triangle {
+        a: Vec3::new(27_899.107, 97_985.766, 57_897.117),
+        b: Vec3::new(27_898.635, 97_986.86, 57_896.203),
+        c: Vec3::new(27_898.553, 97_987.05, 57_896.406),
+    });
+    let cyl = Shape::Cylinder(Cylinder::new(0.1, 0.07).unwrap());
+    let pose = Isometry::new(
+        Vec3::new(27_899.076, 97_986.12, 57_896.96),
+        Quat::from_xyzw(-0.399_846_35, 0.375_305_95, -0.281_321_97, 0.787_480_95),
+    );
+    for c in [
+        distance(&tri, &Isometry::IDENTITY, &cyl, &pose).unwrap(),
+        distance(&cyl, &pose, &tri, &Isometry::IDENTITY).unwrap(),
+    ] {
+        assert!(c.distance.is_finite() && c.distance.abs() < 0.05, "{c:?}");
+        assert!((c.normal.length() - 1.0).abs() < 1e-3, "{c:?}");
+    }
+}

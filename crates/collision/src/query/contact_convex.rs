@@ -200,7 +200,15 @@ pub fn contact_gjk_epa_unguarded_warm(
             if signed > prediction {
                 return (GjkEpa::Beyond, point_b - point_a);
             }
-            let n = (point_b - point_a) / distance;
+            let mut n = (point_b - point_a) / distance;
+            if (n.length_squared() - 1.0).abs() > 1.0e-3 {
+                // The witnesses lost the gap to round-off (coordinates far larger than the
+                // distance, e.g. 1e5 against 5e-5 in f32): GJK's own direction is unit.
+                n = (-v)
+                    .try_normalize()
+                    .or_else(|| (point_b - point_a).try_normalize())
+                    .unwrap_or(Vec3::Y);
+            }
             GjkEpa::Separated(Contact {
                 distance: signed,
                 point_a: point_a + n * ra,
