@@ -14,6 +14,10 @@ use carom_collision::{CaromError, Result};
 use serde::{Deserialize, Serialize};
 use std::sync::Arc;
 
+/// Largest gravity scale a body accepts: beyond it the gravity's velocity change of a step
+/// approaches the range of f32 and means nothing physical.
+pub const MAX_GRAVITY_SCALE: Real = 1.0e6;
+
 /// How a body moves.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
 pub enum BodyType {
@@ -136,8 +140,8 @@ impl BodyDesc {
     /// Checks every value and computes the mass properties.
     pub fn validate(&self) -> Result<(Isometry, ResolvedMass)> {
         let pose = check_isometry("body.pose", self.pose)?;
-        check_finite_vec("body.linear_velocity", self.linear_velocity)?;
-        check_finite_vec("body.angular_velocity", self.angular_velocity)?;
+        crate::body_set::check_vector("body.linear_velocity", self.linear_velocity)?;
+        crate::body_set::check_vector("body.angular_velocity", self.angular_velocity)?;
         check_non_negative("body.friction", self.friction)?;
         let e = check_non_negative("body.restitution", self.restitution)?;
         if e > 1.0 {
@@ -145,7 +149,14 @@ impl BodyDesc {
         }
         check_non_negative("body.linear_damping", self.linear_damping)?;
         check_non_negative("body.angular_damping", self.angular_damping)?;
-        check_finite("body.gravity_scale", self.gravity_scale)?;
+        let g = check_finite("body.gravity_scale", self.gravity_scale)?;
+        if g.abs() > MAX_GRAVITY_SCALE {
+            return Err(CaromError::invalid(
+                "body.gravity_scale",
+                g,
+                format!("must be within ±{MAX_GRAVITY_SCALE:e}"),
+            ));
+        }
         check_positive("body.max_linear_speed", self.max_linear_speed)?;
         check_positive("body.max_angular_speed", self.max_angular_speed)?;
         let mass = match self.body_type {

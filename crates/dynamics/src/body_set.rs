@@ -373,69 +373,102 @@ impl BodySet {
         Ok(())
     }
 
-    /// Sets the linear velocity; wakes the body. Static bodies reject it.
+    /// Sets the linear velocity; wakes the body. Static bodies reject it, as do velocities
+    /// whose length overflows.
     pub fn set_linear_velocity(&mut self, h: BodyHandle, v: Vec3) -> Result<()> {
         let i = self.movable_slot(h, "linear_velocity")?;
-        self.linear_velocity[i] = check_finite_vec("linear_velocity", v)?;
+        self.linear_velocity[i] = check_vector("linear_velocity", v)?;
         self.wake_slot(i);
         Ok(())
     }
 
-    /// Sets the angular velocity; wakes the body. Static bodies reject it.
+    /// Sets the angular velocity; wakes the body. Static bodies reject it, as do velocities
+    /// whose length overflows.
     pub fn set_angular_velocity(&mut self, h: BodyHandle, w: Vec3) -> Result<()> {
         let i = self.movable_slot(h, "angular_velocity")?;
-        self.angular_velocity[i] = check_finite_vec("angular_velocity", w)?;
+        self.angular_velocity[i] = check_vector("angular_velocity", w)?;
         self.wake_slot(i);
         Ok(())
     }
 
-    /// Adds a force (N) at the centre of mass for the next step; wakes the body.
+    /// Sets the linear and angular velocities of several bodies: every handle and value is
+    /// checked (as [`BodySet::set_linear_velocity`]) before any body changes.
+    pub fn set_velocities(&mut self, items: &[(BodyHandle, Vec3, Vec3)]) -> Result<()> {
+        let mut slots = Vec::with_capacity(items.len());
+        for (k, &(h, v, w)) in items.iter().enumerate() {
+            let i = self.movable_slot(h, &format!("handles[{k}]"))?;
+            check_vector(&format!("linear[{k}]"), v)?;
+            check_vector(&format!("angular[{k}]"), w)?;
+            slots.push(i);
+        }
+        for (&i, &(_, v, w)) in slots.iter().zip(items) {
+            self.linear_velocity[i] = v;
+            self.angular_velocity[i] = w;
+            self.wake_slot(i);
+        }
+        Ok(())
+    }
+
+    /// Adds a force (N) at the centre of mass for the next step; wakes the body. A force
+    /// whose sum with the forces already added overflows is refused.
     pub fn add_force(&mut self, h: BodyHandle, f: Vec3) -> Result<()> {
         let i = self.slot(h)?;
-        self.force[i] += check_finite_vec("force", f)?;
+        self.force[i] = check_vector("force", self.force[i] + check_finite_vec("force", f)?)?;
         self.forces_zero = false;
         self.wake_slot(i);
         Ok(())
     }
 
-    /// Adds a torque (N·m) for the next step; wakes the body.
+    /// Adds a torque (N·m) for the next step; wakes the body (refused as in
+    /// [`BodySet::add_force`]).
     pub fn add_torque(&mut self, h: BodyHandle, t: Vec3) -> Result<()> {
         let i = self.slot(h)?;
-        self.torque[i] += check_finite_vec("torque", t)?;
+        self.torque[i] = check_vector("torque", self.torque[i] + check_finite_vec("torque", t)?)?;
         self.forces_zero = false;
         self.wake_slot(i);
         Ok(())
     }
 
-    /// Adds a force at a world point (force plus the torque `(p − com) × f`).
+    /// Adds a force at a world point (force plus the torque `(p − com) × f`; refused as in
+    /// [`BodySet::add_force`]).
     pub fn add_force_at_point(&mut self, h: BodyHandle, f: Vec3, point: Vec3) -> Result<()> {
         let i = self.slot(h)?;
         check_finite_vec("force", f)?;
         check_finite_vec("point", point)?;
-        self.force[i] += f;
-        self.torque[i] += (point - self.position[i]).cross(f);
+        let force = check_vector("force", self.force[i] + f)?;
+        let torque = check_vector(
+            "torque",
+            self.torque[i] + (point - self.position[i]).cross(f),
+        )?;
+        self.force[i] = force;
+        self.torque[i] = torque;
         self.forces_zero = false;
         self.wake_slot(i);
         Ok(())
     }
 
     /// Applies an impulse (N·s) at a world point: changes the velocities now; wakes the body.
+    /// An impulse that would make a velocity's length overflow is refused.
     pub fn apply_impulse(&mut self, h: BodyHandle, impulse: Vec3, point: Vec3) -> Result<()> {
         let i = self.slot(h)?;
         check_finite_vec("impulse", impulse)?;
         check_finite_vec("point", point)?;
-        self.linear_velocity[i] += impulse * self.inv_mass[i];
-        self.angular_velocity[i] +=
-            self.inv_inertia_world[i] * (point - self.position[i]).cross(impulse);
+        let v = self.linear_velocity[i] + impulse * self.inv_mass[i];
+        let w = self.angular_velocity[i]
+            + self.inv_inertia_world[i] * (point - self.position[i]).cross(impulse);
+        self.linear_velocity[i] = check_vector("impulse", v)?;
+        self.angular_velocity[i] = check_vector("impulse", w)?;
         self.wake_slot(i);
         Ok(())
     }
 
-    /// Applies an angular impulse (N·m·s); wakes the body.
+    /// Applies an angular impulse (N·m·s); wakes the body (refused as in
+    /// [`BodySet::apply_impulse`]).
     pub fn apply_angular_impulse(&mut self, h: BodyHandle, impulse: Vec3) -> Result<()> {
         let i = self.slot(h)?;
         check_finite_vec("angular_impulse", impulse)?;
-        self.angular_velocity[i] += self.inv_inertia_world[i] * impulse;
+        let w = self.angular_velocity[i] + self.inv_inertia_world[i] * impulse;
+        self.angular_velocity[i] = check_vector("angular_impulse", w)?;
         self.wake_slot(i);
         Ok(())
     }
@@ -503,6 +536,21 @@ pub(crate) fn world_inertia(q: Quat, inv_local: &Mat3) -> Mat3 {
 pub(crate) fn world_inertia_reference(q: Quat, inv_local: &Mat3) -> Mat3 {
     let r = Mat3::from_quat(q);
     r * *inv_local * r.transpose()
+}
+
+/// `v` when it is finite and its length is too (speeds, forces and impulses past ~1.8e19 in
+/// f32 overflow the squared length that the step's margins and clamps use); an error naming
+/// `name` otherwise.
+pub(crate) fn check_vector(name: &str, v: Vec3) -> Result<Vec3> {
+    let v = check_finite_vec(name, v)?;
+    if !v.length().is_finite() {
+        return Err(CaromError::invalid(
+            name,
+            format!("{:?}", v.to_array()),
+            "its length overflows",
+        ));
+    }
+    Ok(v)
 }
 
 #[cfg(test)]

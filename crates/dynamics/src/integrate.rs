@@ -286,6 +286,35 @@ fn skew_mul(w: Vec3, m: Mat3) -> Mat3 {
     Mat3::from_cols(w.cross(m.x_axis), w.cross(m.y_axis), w.cross(m.z_axis))
 }
 
+/// `v` (of squared length `v2 > max²`) shortened to length `max`. When `v2` overflows
+/// (speeds beyond ~1.8e19 in f32, from a huge impulse, force or gravity scale) the vector is
+/// first divided by its largest component, and infinite components give the direction, so
+/// the clamp keeps the direction instead of zeroing the speed or making NaN.
+#[inline]
+pub(crate) fn clamp_length(v: Vec3, v2: Real, max: Real) -> Vec3 {
+    if v2.is_finite() {
+        return v * (max / v2.sqrt());
+    }
+    clamp_length_overflowing(v, max)
+}
+
+#[cold]
+#[inline(never)]
+fn clamp_length_overflowing(v: Vec3, max: Real) -> Vec3 {
+    let m = v.abs().max_element();
+    let dir = if m.is_finite() {
+        v / m
+    } else {
+        // Infinite components (NaN ones count for nothing).
+        Vec3::select(
+            v.abs().cmpeq(Vec3::splat(Real::INFINITY)),
+            v.signum(),
+            Vec3::ZERO,
+        )
+    };
+    dir.normalize_or_zero() * max
+}
+
 /// Clamps a body's speeds to its limits.
 pub(crate) fn clamp_speeds(set: &BodySet, bodies: &mut [SolverBody]) {
     for (i, b) in bodies.iter_mut().enumerate() {
@@ -295,11 +324,11 @@ pub(crate) fn clamp_speeds(set: &BodySet, bodies: &mut [SolverBody]) {
         let info = &set.info[i];
         let v2 = b.v.length_squared();
         if v2 > info.max_linear_speed * info.max_linear_speed {
-            b.v *= info.max_linear_speed / v2.sqrt();
+            b.v = clamp_length(b.v, v2, info.max_linear_speed);
         }
         let w2 = b.w.length_squared();
         if w2 > info.max_angular_speed * info.max_angular_speed {
-            b.w *= info.max_angular_speed / w2.sqrt();
+            b.w = clamp_length(b.w, w2, info.max_angular_speed);
         }
     }
 }
@@ -376,11 +405,11 @@ pub(crate) fn clamp_and_integrate_position(
     if t.flags & DYNAMIC != 0 {
         let v2 = b.v.length_squared();
         if v2 > t.max_v_sq {
-            b.v *= t.max_v / v2.sqrt();
+            b.v = clamp_length(b.v, v2, t.max_v);
         }
         let w2 = b.w.length_squared();
         if w2 > t.max_w_sq {
-            b.w *= t.max_w / w2.sqrt();
+            b.w = clamp_length(b.w, w2, t.max_w);
         }
     }
     let (v, w) = (b.v, b.w);

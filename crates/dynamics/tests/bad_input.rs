@@ -161,3 +161,80 @@ fn stale_handles_and_removed_bodies_with_joints() {
     );
     assert!(w.create_joint(&desc).is_err(), "joint to a removed body");
 }
+
+/// Session 27's sweep: velocities, impulses and forces whose length overflows f32 are
+/// refused (they made every later step fail on an infinite margin), several velocities are
+/// checked before any changes, and a speed clamp that overflows keeps the direction (2e19
+/// became 0, a gravity scale of 1e38 made NaN).
+#[test]
+fn huge_velocities_impulses_and_forces() {
+    let mut w = DynamicsWorld::new(WorldParams::default()).unwrap();
+    let ground = add_ground(&mut w);
+    let b = w
+        .create_body(&BodyDesc::dynamic(
+            sphere(0.5),
+            Isometry::from_translation(Vec3::Y * 5.0),
+            1000.0,
+        ))
+        .unwrap();
+    let before = w.state_hash();
+    let huge = Vec3::new(Real::MAX, Real::MAX, 0.0);
+    err_names(
+        w.bodies_mut().set_linear_velocity(b, huge),
+        "linear_velocity",
+    );
+    err_names(
+        w.bodies_mut().set_angular_velocity(b, huge),
+        "angular_velocity",
+    );
+    err_names(w.bodies_mut().apply_impulse(b, huge, Vec3::ZERO), "impulse");
+    err_names(
+        w.bodies_mut().apply_angular_impulse(b, huge),
+        "angular_impulse",
+    );
+    err_names(w.bodies_mut().add_force(b, huge), "force");
+    err_names(w.bodies_mut().add_torque(b, huge), "torque");
+    // The second item is refused, so the first does not change either.
+    err_names(
+        w.bodies_mut()
+            .set_velocities(&[(b, Vec3::X, Vec3::ZERO), (ground, Vec3::X, Vec3::ZERO)]),
+        "handles[1]",
+    );
+    assert_eq!(before, w.state_hash(), "refused calls change nothing");
+    let mut d = BodyDesc::dynamic(sphere(0.5), Isometry::IDENTITY, 1000.0);
+    d.gravity_scale = 1e30;
+    err_names(w.create_body(&d), "body.gravity_scale");
+    // Past sqrt(MAX) (1.8e19 m/s in f32) the squared length overflows: refused; below it
+    // the step clamps to the body's limit.
+    let root = Real::MAX.sqrt();
+    err_names(
+        w.bodies_mut()
+            .set_linear_velocity(b, Vec3::X * (1.5 * root)),
+        "linear_velocity",
+    );
+    w.bodies_mut()
+        .set_linear_velocity(b, Vec3::X * (0.5 * root))
+        .unwrap();
+    w.step(1.0 / 60.0, &mut []).unwrap();
+    let v = w.bodies().linear_velocity(b).unwrap();
+    assert!((v.x - 400.0).abs() < 1e-2 && v.is_finite(), "{v}");
+    // Forces adding up past the limit: the sum is refused, the earlier force kept. On a
+    // light body its velocity change overflows the clamp's square, which keeps the direction.
+    let light = w
+        .create_body(&BodyDesc::dynamic(
+            sphere(0.5),
+            Isometry::from_translation(Vec3::X * 5.0),
+            1e-6,
+        ))
+        .unwrap();
+    w.bodies_mut()
+        .add_force(light, Vec3::NEG_X * (0.5 * root))
+        .unwrap();
+    err_names(w.bodies_mut().add_force(light, Vec3::NEG_X * root), "force");
+    w.step(1.0 / 60.0, &mut []).unwrap();
+    let v = w.bodies().linear_velocity(light).unwrap();
+    assert!(
+        v.is_finite() && (v.length() - 400.0).abs() < 1e-2 && v.x < -399.0,
+        "{v}"
+    );
+}

@@ -21,7 +21,7 @@ use crate::world_joints::{joint_bits, joint_desc, joint_handle, JointOptions};
 use crate::world_queries::{bits, PyWorldContacts, PyWorldRayHit, PyWorldShapeCastHit};
 use crate::world_snapshot::{decode, encode};
 use carom_collision::broadphase::{Filter, Method};
-use carom_collision::math::{check_finite_vec, Isometry, Real};
+use carom_collision::math::{Isometry, Real};
 use carom_dynamics::{BodyDesc, BodyHandle, BodyType, MassSpec, PipelineParams, SolverKind, World};
 use numpy::ndarray::Array2;
 use numpy::IntoPyArray;
@@ -358,17 +358,14 @@ impl PyWorld {
                 ang.len()
             )));
         }
-        for (i, (v, w)) in lin.iter().zip(&ang).enumerate() {
-            core(|| check_finite_vec(&format!("linear[{i}]"), *v).map(|_| ()))?;
-            core(|| check_finite_vec(&format!("angular[{i}]"), *w).map(|_| ()))?;
-        }
         let hs = self.handles_arg(Some(handles))?;
-        let bodies = self.world.bodies_mut();
-        for ((h, v), w) in hs.into_iter().zip(lin).zip(ang) {
-            core(|| bodies.set_linear_velocity(h, v))?;
-            core(|| bodies.set_angular_velocity(h, w))?;
-        }
-        Ok(())
+        let items: Vec<_> = hs
+            .into_iter()
+            .zip(lin)
+            .zip(ang)
+            .map(|((h, v), w)| (h, v, w))
+            .collect();
+        core(|| self.world.bodies_mut().set_velocities(&items))
     }
 
     /// Applies an impulse (N·s, world frame) at a world `point` of body `handle`.
