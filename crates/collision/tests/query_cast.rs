@@ -338,3 +338,68 @@ fn spinning_shapes_that_pass_each_other_report_no_hit() {
         .expect("the rising plane reaches the box");
     assert!((h.toi - 0.5).abs() < 1e-3, "{}", h.toi);
 }
+
+/// Casts against a plane (session 27: refused, so one plane body made every world shape
+/// cast fail): the time is the first at which the distance reaches zero, in both argument
+/// orders, for convex shapes and a compound of them.
+#[test]
+fn casts_against_planes_match_the_distance() {
+    let mut rng = Rng(31);
+    let plane =
+        Shape::Plane(carom_collision::shape::Plane::new(Vec3::new(0.3, 1.0, -0.2), 0.5).unwrap());
+    let mut all = shapes(&mut rng);
+    let parts: Vec<(Isometry, std::sync::Arc<Shape>)> = all
+        .iter()
+        .take(2)
+        .enumerate()
+        .map(|(i, s)| {
+            (
+                Isometry::from_translation(Vec3::X * i as Real),
+                std::sync::Arc::new(s.clone()),
+            )
+        })
+        .collect();
+    all.push(Shape::Compound(
+        carom_collision::shape::Compound::new(parts).unwrap(),
+    ));
+    let mut hits = 0;
+    for s in &all {
+        for _ in 0..20 {
+            let pose = Isometry::new(rng.vec(1.0) + Vec3::Y * 3.0, rng.quat());
+            let vel = rng.vec(2.0) - Vec3::Y * 4.0;
+            let h =
+                shape_cast(s, &pose, vel, &plane, &Isometry::IDENTITY, Vec3::ZERO, 1.0).unwrap();
+            let d = |t: Real| {
+                let p = Isometry::new(pose.translation + vel * t, pose.rotation);
+                distance(s, &p, &plane, &Isometry::IDENTITY)
+                    .unwrap()
+                    .distance
+            };
+            let swapped =
+                shape_cast(&plane, &Isometry::IDENTITY, -vel, s, &pose, Vec3::ZERO, 1.0).unwrap();
+            match h {
+                Some(h) => {
+                    hits += 1;
+                    assert!(
+                        d(h.toi).abs() < 1e-4,
+                        "{}: gap {} at {}",
+                        s.kind_name(),
+                        d(h.toi),
+                        h.toi
+                    );
+                    assert!(
+                        h.toi == 0.0 || d(h.toi - 1e-3) > 0.0,
+                        "not the first contact"
+                    );
+                    let w = swapped.expect("the swapped cast hits too");
+                    assert!((w.toi - h.toi).abs() < 1e-5 && (w.normal + h.normal).length() < 1e-4);
+                }
+                None => {
+                    assert!(d(1.0) > 0.0, "{}: missed", s.kind_name());
+                    assert!(swapped.is_none());
+                }
+            }
+        }
+    }
+    assert!(hits > 40, "{hits}");
+}

@@ -11,13 +11,14 @@ use super::support_adapters::{core_radius, Core, MinkowskiDiff, Transformed};
 use crate::error::{CaromError, Result};
 use crate::math::{check_finite_vec, Isometry, Real, Vec3};
 use crate::midphase::TriangleSource;
-use crate::shape::{ConvexRef, Shape};
+use crate::shape::{ConvexRef, Plane, Shape, SupportMap};
 
 /// Casts `a` (at `pose_a`, moving by `vel_a` per unit time) and `b` (at `pose_b`, moving by
 /// `vel_b`) until they touch, for times in `[0, max_toi]`. Returns the first time of contact
 /// with the witness points and normal at that time (world space), or `None`. Convex shapes,
 /// compounds (by recursion), meshes and heightfields (over the triangles B's swept box meets)
-/// are supported; planes are not.
+/// are supported, and planes against convex shapes and compounds of them (not against
+/// meshes, heightfields or planes).
 pub fn shape_cast(
     a: &Shape,
     pose_a: &Isometry,
@@ -69,7 +70,18 @@ pub fn shape_cast_local(
         }
     };
     match (a, b) {
-        (Shape::Plane(_), _) | (_, Shape::Plane(_)) => {
+        (Shape::Plane(p), _) if b.is_convex() => {
+            return Ok(shape_cast_plane_convex(
+                p,
+                b.as_convex().expect("checked"),
+                pose_ab,
+                rel_vel,
+                max_toi,
+            ));
+        }
+        (Shape::Plane(_), Shape::Plane(_))
+        | (Shape::Plane(_), Shape::TriMesh(_) | Shape::HeightField(_))
+        | (Shape::TriMesh(_) | Shape::HeightField(_), Shape::Plane(_)) => {
             return Err(CaromError::Unsupported(format!(
                 "shape cast between a {} and a {}",
                 a.kind_name(),
@@ -94,8 +106,8 @@ pub fn shape_cast_local(
             let src = TriangleSource::of(a).expect("a mesh or heightfield");
             keep(shape_cast_triangles(src, b, pose_ab, rel_vel, max_toi)?);
         }
-        (_, Shape::Compound(_) | Shape::TriMesh(_) | Shape::HeightField(_)) => {
-            // B is the compound, mesh or heightfield: swap roles (A moves by -rel_vel
+        (_, Shape::Compound(_) | Shape::TriMesh(_) | Shape::HeightField(_) | Shape::Plane(_)) => {
+            // B is the compound, mesh, heightfield or plane: swap roles (A moves by -rel_vel
             // relative to B).
             let pose_ba = pose_ab.inverse();
             let rel = pose_ba.transform_vector(-rel_vel);
@@ -122,6 +134,47 @@ pub fn shape_cast_local(
         }
     }
     Ok(best)
+}
+
+/// Linear cast of convex B (at `pose_ab`, moving by `rel_vel`) against plane A (the
+/// half-space `n·x <= offset`), exact: B's support point along `-n` is the first to reach
+/// the plane. Already touching or overlapping gives time 0 with the contact.
+pub fn shape_cast_plane_convex(
+    a: &Plane,
+    b: ConvexRef<'_>,
+    pose_ab: &Isometry,
+    rel_vel: Vec3,
+    max_toi: Real,
+) -> Option<ShapeCastHit> {
+    let n = a.normal();
+    let p = b.support_world(pose_ab, -n);
+    let d = a.signed_distance(p);
+    if d <= 0.0 {
+        return Some(ShapeCastHit {
+            toi: 0.0,
+            point_a: p - n * d,
+            point_b: p,
+            normal: n,
+            initially_overlapping: d < 0.0,
+        });
+    }
+    let approach = -rel_vel.dot(n);
+    if approach <= 0.0 {
+        return None;
+    }
+    let toi = d / approach;
+    (toi <= max_toi).then(|| {
+        let q = p + rel_vel * toi;
+        // On the plane: B's point moved onto it, A's is its projection.
+        let on = q - n * a.signed_distance(q);
+        ShapeCastHit {
+            toi,
+            point_a: on,
+            point_b: on,
+            normal: n,
+            initially_overlapping: false,
+        }
+    })
 }
 
 /// Linear cast of two convex shapes in A's frame.
