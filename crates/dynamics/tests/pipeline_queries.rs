@@ -403,3 +403,56 @@ fn queries_after_steps_and_moves_answer_like_fresh_ones() {
     );
     assert!(ops.iter().all(|&n| n > 20), "{ops:?}");
 }
+
+/// Session 27's sweep: after a body slot is reused, an exact tie of two identical boxes went
+/// to the later collision object in shape casts, while rays took the lower body slot; and a
+/// plane body made every shape cast fail (plane casts were unsupported).
+#[test]
+fn shape_cast_ties_go_to_the_lower_slot_and_planes_are_cast_against() {
+    let mut w = world(false);
+    let cube = cuboid(Vec3::ONE);
+    let a = w
+        .add_body(&BodyDesc::fixed(cube.clone(), Isometry::IDENTITY))
+        .unwrap();
+    let b = w
+        .add_body(&BodyDesc::fixed(cube.clone(), Isometry::IDENTITY))
+        .unwrap();
+    w.remove_body(a).unwrap();
+    let d = w
+        .add_body(&BodyDesc::fixed(cube, Isometry::IDENTITY))
+        .unwrap();
+    assert!(d.index < b.index, "the freed slot is reused");
+    w.step(1.0 / 60.0).unwrap();
+    let ray = w
+        .raycast(Vec3::new(-5.0, 0.0, 0.0), Vec3::X, 100.0, u32::MAX)
+        .unwrap()
+        .unwrap();
+    let ball = sphere(0.5);
+    let from = Isometry::from_translation(Vec3::new(-5.0, 0.0, 0.0));
+    let cast = w
+        .shape_cast(&ball, &from, Vec3::X * 10.0, 1.0, u32::MAX)
+        .unwrap()
+        .unwrap();
+    assert_eq!((ray.body, cast.body), (d, d));
+    // A plane below everything: the cast sideways still hits the box; one downwards the plane.
+    let plane: Arc<Shape> = Arc::new(
+        carom_dynamics::collision::shape::Plane::new(Vec3::Y, -3.0)
+            .unwrap()
+            .into(),
+    );
+    let p = w
+        .add_body(&BodyDesc::fixed(plane, Isometry::IDENTITY))
+        .unwrap();
+    w.step(1.0 / 60.0).unwrap();
+    let cast = w
+        .shape_cast(&ball, &from, Vec3::X * 10.0, 1.0, u32::MAX)
+        .unwrap()
+        .unwrap();
+    assert_eq!(cast.body, d);
+    let down = w
+        .shape_cast(&ball, &from, Vec3::NEG_Y * 10.0, 1.0, u32::MAX)
+        .unwrap()
+        .unwrap();
+    assert_eq!(down.body, p);
+    assert!((down.hit.toi - 0.25).abs() < 1e-5, "{}", down.hit.toi);
+}

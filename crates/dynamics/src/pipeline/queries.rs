@@ -312,7 +312,11 @@ impl<'w> WorldQuery<'w> {
             let limit = best.map_or(max_time, |b| b.hit.toi);
             let hit = shape_cast(shape, &pose, velocity, other, other_pose, Vec3::ZERO, limit)?;
             if let Some(hit) = hit {
-                if best.is_none_or(|b| hit.toi < b.hit.toi) {
+                // Ties go to the lower body slot (objects are not in slot order once slots
+                // are reused), as for rays.
+                if best.is_none_or(|b| {
+                    hit.toi < b.hit.toi || (hit.toi == b.hit.toi && body.index < b.body.index)
+                }) {
                     best = Some(BodyShapeCastHit { body: *body, hit });
                 }
             }
