@@ -90,3 +90,53 @@ def test_removing_a_body_while_step_runs_cannot_corrupt() -> None:
     w.step(60)
     assert np.isfinite(w.poses()).all()
     assert all(w.poses([h])[0, 1] > 0 for h in hs if h != hs[5])
+
+
+def test_out_of_range_ints_are_value_errors_and_bools_type_errors() -> None:
+    # Session 27's sweep: pyo3 raised OverflowError (neither ValueError nor TypeError) for
+    # negative or too large ints, and True was taken for body 1.
+    w = carom.World()
+    b = w.add_body(carom.Sphere(1.0))
+    cw = carom.CollisionWorld()
+    calls = [
+        lambda: w.remove_body(-1),
+        lambda: w.poses([2**64]),
+        lambda: w.add_body(carom.Sphere(1.0), group=-1),
+        lambda: w.add_body(carom.Sphere(1.0), mask=2**32),
+        lambda: w.add_body(carom.Sphere(1.0), user_data=-1),
+        lambda: w.step(-1),
+        lambda: w.raycast([0, 0, 5], [0, 0, -1], mask=-1),
+        lambda: carom.World(substeps=2**70),
+        lambda: cw.add(carom.Sphere(1.0), group=-1),
+        lambda: cw.remove(-1),
+        lambda: carom.BroadPhase().add([0, 0, 0], [1, 1, 1], group=2**70),
+    ]
+    before = w.to_bytes()
+    for call in calls:
+        with pytest.raises(carom.CaromError, match="invalid"):
+            call()
+    with pytest.raises(TypeError, match="bool"):
+        w.remove_body(True)
+    assert w.to_bytes() == before
+    assert -1 not in w and True not in w and "x" not in w and b in w
+
+
+def test_rejected_velocities_change_nothing_and_huge_speeds_are_refused() -> None:
+    w = carom.World(gravity=[0, -9.81, 0])
+    ground = w.add_body(carom.Box([5, 0.5, 5]), [0, -0.5, 0, 0, 0, 0, 1], is_static=True)
+    ball = w.add_body(carom.Sphere(0.5), [0, 2, 0, 0, 0, 0, 1])
+    before = w.to_bytes()
+    with pytest.raises(ValueError, match=r"handles\[1\]"):
+        w.set_velocities([ball, ground], [[1, 0, 0], [1, 0, 0]], [[0, 0, 0], [0, 0, 0]])
+    with pytest.raises(ValueError, match="overflows"):
+        w.set_velocities([ball], [[1e25, 0, 0]], [[0, 0, 0]])
+    with pytest.raises(ValueError, match="overflows"):
+        w.apply_impulse(ball, [1e38, 1e38, 0], [0, 2, 0])
+    with pytest.raises(ValueError, match="gravity_scale"):
+        w.add_body(carom.Sphere(0.5), gravity_scale=1e30)
+    assert w.to_bytes() == before
+    # A speed just under the overflow is clamped to the body's limit, keeping its direction.
+    w.set_velocities([ball], [[0, 0, 1e19]], [[0, 0, 0]])
+    w.step()
+    v = w.velocities([ball])[0][0]
+    assert np.all(np.isfinite(v)) and abs(np.linalg.norm(v) - 400.0) < 0.1 and v[2] > 399.0

@@ -226,8 +226,8 @@ impl PyBroadPhase {
         py: Python<'py>,
         aabb_min: &Bound<'py, PyAny>,
         aabb_max: &Bound<'py, PyAny>,
-        group: i64,
-        mask: i64,
+        #[pyo3(from_py_with = crate::convert::int_arg::<i64>)] group: i64,
+        #[pyo3(from_py_with = crate::convert::int_arg::<i64>)] mask: i64,
         is_static: bool,
     ) -> PyResult<Bound<'py, PyAny>> {
         let filter = Filter {
@@ -305,8 +305,8 @@ impl PyBroadPhase {
     fn set_filter(
         &mut self,
         handle: &Bound<'_, PyAny>,
-        group: i64,
-        mask: i64,
+        #[pyo3(from_py_with = crate::convert::int_arg::<i64>)] group: i64,
+        #[pyo3(from_py_with = crate::convert::int_arg::<i64>)] mask: i64,
         is_static: bool,
     ) -> PyResult<()> {
         let filter = Filter {

@@ -10,6 +10,7 @@
 //! as in `ProxyHandle::to_bits`).
 
 use crate::convert::scalar;
+use crate::convert::Int;
 use crate::errors::{core, invalid};
 use crate::pose::{extract_isometry, extract_poses};
 use crate::queries::shape_arg;
@@ -246,8 +247,8 @@ impl PyCollisionWorld {
         &mut self,
         shape: &Bound<'_, PyAny>,
         pose: Option<&Bound<'_, PyAny>>,
-        group: u32,
-        mask: u32,
+        #[pyo3(from_py_with = crate::convert::int_arg::<u32>)] group: u32,
+        #[pyo3(from_py_with = crate::convert::int_arg::<u32>)] mask: u32,
         is_static: bool,
         sensor: bool,
     ) -> PyResult<u64> {
@@ -264,14 +265,19 @@ impl PyCollisionWorld {
     }
 
     /// Moves object `handle` to `pose` (taken into account by the next `step`).
-    fn set_pose(&mut self, handle: u64, pose: &Bound<'_, PyAny>) -> PyResult<()> {
+    fn set_pose(&mut self, handle: Int<u64>, pose: &Bound<'_, PyAny>) -> PyResult<()> {
+        let handle = handle.0;
         let p = extract_isometry(Some(pose), "pose")?;
         core(|| self.world.set_pose(self::handle(handle), p))
     }
 
     /// Moves many objects: `handles` (N ints) to `poses` (`(N, 7)`). Checked before any
     /// object moves: on an error nothing changes.
-    fn set_poses(&mut self, handles: Vec<u64>, poses: &Bound<'_, PyAny>) -> PyResult<()> {
+    fn set_poses(
+        &mut self,
+        #[pyo3(from_py_with = crate::convert::u64s_arg)] handles: Vec<u64>,
+        poses: &Bound<'_, PyAny>,
+    ) -> PyResult<()> {
         let (ps, single) = extract_poses(Some(poses), "poses")?;
         if single && handles.len() != 1 || ps.len() != handles.len() {
             return Err(invalid(format!(
@@ -295,12 +301,14 @@ impl PyCollisionWorld {
     }
 
     /// Removes object `handle`; its pairs end at the next `step` (with `end` events).
-    fn remove(&mut self, handle: u64) -> PyResult<()> {
+    fn remove(&mut self, handle: Int<u64>) -> PyResult<()> {
+        let handle = handle.0;
         core(|| self.world.remove(self::handle(handle)).map(|_| ()))
     }
 
     /// The current pose of object `handle` as a `(7,)` array.
-    fn pose<'py>(&self, py: Python<'py>, handle: u64) -> PyResult<Bound<'py, PyAny>> {
+    fn pose<'py>(&self, py: Python<'py>, handle: Int<u64>) -> PyResult<Bound<'py, PyAny>> {
+        let handle = handle.0;
         let o = core(|| self.world.get(self::handle(handle)))?;
         let p = crate::pose::Pose64::from_isometry(&o.pose).to_array();
         Ok(Array1::from_vec(p.to_vec()).into_pyarray(py).into_any())

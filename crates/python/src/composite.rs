@@ -356,7 +356,10 @@ impl PyCompound {
     /// A new compound without child `index` (0 <= index < num_children); as in the Rust
     /// `Compound::remove_child`, the last child takes its index. The only child cannot be
     /// removed. This compound is unchanged (see `with_child`).
-    fn without_child<'py>(slf: &Bound<'py, Self>, index: i64) -> PyResult<Bound<'py, PyAny>> {
+    fn without_child<'py>(
+        slf: &Bound<'py, Self>,
+        #[pyo3(from_py_with = crate::convert::int_arg::<i64>)] index: i64,
+    ) -> PyResult<Bound<'py, PyAny>> {
         let i = child_index(slf, index)?;
         edited(slf, |c| c.remove_child(i).map(|_| ()))
     }
@@ -366,7 +369,7 @@ impl PyCompound {
     /// `with_child`).
     fn with_child_pose<'py>(
         slf: &Bound<'py, Self>,
-        index: i64,
+        #[pyo3(from_py_with = crate::convert::int_arg::<i64>)] index: i64,
         pose: &Bound<'py, PyAny>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let i = child_index(slf, index)?;

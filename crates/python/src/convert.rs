@@ -275,3 +275,77 @@ pub fn indices_out<'py>(py: Python<'py>, idx: &[u32]) -> Bound<'py, PyArray1<i64
 pub fn triples_out<'py>(py: Python<'py>, tris: &[[u32; 3]]) -> Bound<'py, PyArray2<i64>> {
     Array2::from_shape_fn((tris.len(), 3), |(i, j)| i64::from(tris[i][j])).into_pyarray(py)
 }
+
+/// An integer argument of type `T` (handles, filter bits, counts). pyo3 raises
+/// `OverflowError` for an int outside `T`'s range, which is neither a `ValueError` nor a
+/// `TypeError`; this raises `CaromError` (a `ValueError`) naming the value and the range,
+/// and refuses `bool` (a `TypeError`: `True` is not body 1).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Int<T>(pub T);
+
+/// The range of an [`Int`] argument, for its error message.
+pub trait IntRange {
+    /// `[min, max]` as text.
+    const RANGE: &'static str;
+}
+
+impl IntRange for u32 {
+    const RANGE: &'static str = "[0, 2**32 - 1]";
+}
+
+impl IntRange for u64 {
+    const RANGE: &'static str = "[0, 2**64 - 1]";
+}
+
+impl IntRange for i64 {
+    const RANGE: &'static str = "[-2**63, 2**63 - 1]";
+}
+
+impl<'a, 'py, T> FromPyObject<'a, 'py> for Int<T>
+where
+    T: FromPyObject<'a, 'py, Error = PyErr> + IntRange,
+{
+    type Error = PyErr;
+
+    fn extract(ob: pyo3::Borrowed<'a, 'py, PyAny>) -> PyResult<Self> {
+        let shown = ob.to_owned();
+        if ob.is_instance_of::<pyo3::types::PyBool>() {
+            return Err(PyTypeError::new_err(format!(
+                "expected an int, got bool ({shown})"
+            )));
+        }
+        match ob.extract::<T>() {
+            Ok(v) => Ok(Int(v)),
+            Err(e) if e.is_instance_of::<pyo3::exceptions::PyOverflowError>(ob.py()) => Err(
+                invalid(format!("invalid integer {shown}: must be in {}", T::RANGE)),
+            ),
+            Err(e) => Err(e),
+        }
+    }
+}
+
+/// [`Int`] for a parameter with a default (`#[pyo3(from_py_with = int_arg::<u32>)]`), whose
+/// type must stay the plain integer.
+pub fn int_arg<T>(ob: &Bound<'_, PyAny>) -> PyResult<T>
+where
+    T: for<'a, 'py> FromPyObject<'a, 'py, Error = PyErr> + IntRange,
+{
+    ob.extract::<Int<T>>().map(|i| i.0)
+}
+
+/// A sequence of `u64` (handles) with [`Int`]'s errors.
+pub fn u64s_arg(ob: &Bound<'_, PyAny>) -> PyResult<Vec<u64>> {
+    Ok(ob
+        .extract::<Vec<Int<u64>>>()?
+        .into_iter()
+        .map(|i| i.0)
+        .collect())
+}
+
+/// [`u64s_arg`] or `None`.
+pub fn opt_u64s_arg(ob: &Bound<'_, PyAny>) -> PyResult<Option<Vec<u64>>> {
+    if ob.is_none() {
+        return Ok(None);
+    }
+    u64s_arg(ob).map(Some)
+}

@@ -13,6 +13,7 @@
 //! it (`__reduce__` → `World()` + `__setstate__(bytes)`), so a restored world continues
 //! bit for bit.
 
+use crate::convert::Int;
 use crate::convert::{scalar, vec3, vec3s, vec3s_out};
 use crate::errors::{core, guard, invalid};
 use crate::pose::{extract_isometry, extract_poses, Pose64};
@@ -89,8 +90,8 @@ impl PyWorld {
         method: &str,
         sleeping: bool,
         solver: &str,
-        substeps: i64,
-        iterations: i64,
+        #[pyo3(from_py_with = crate::convert::int_arg::<i64>)] substeps: i64,
+        #[pyo3(from_py_with = crate::convert::int_arg::<i64>)] iterations: i64,
         simd: bool,
         parallel: bool,
         sleep_linear: f64,
@@ -177,12 +178,12 @@ impl PyWorld {
         angular_velocity: Option<&Bound<'_, PyAny>>,
         linear_damping: f64,
         angular_damping: f64,
-        group: u32,
-        mask: u32,
+        #[pyo3(from_py_with = crate::convert::int_arg::<u32>)] group: u32,
+        #[pyo3(from_py_with = crate::convert::int_arg::<u32>)] mask: u32,
         gravity_scale: f64,
         max_linear_speed: f64,
         max_angular_speed: f64,
-        user_data: u64,
+        #[pyo3(from_py_with = crate::convert::int_arg::<u64>)] user_data: u64,
     ) -> PyResult<u64> {
         if is_static && kinematic {
             return Err(invalid(
@@ -230,13 +231,18 @@ impl PyWorld {
     }
 
     /// Removes body `handle` (and every joint attached to it).
-    fn remove_body(&mut self, handle: u64) -> PyResult<()> {
+    fn remove_body(&mut self, handle: Int<u64>) -> PyResult<()> {
+        let handle = handle.0;
         core(|| self.world.remove_body(self::handle(handle)).map(|_| ()))
     }
 
     /// Advances the world by `n` steps of `dt` (GIL released).
     #[pyo3(signature = (n = 1))]
-    fn step(&mut self, py: Python<'_>, n: u32) -> PyResult<()> {
+    fn step(
+        &mut self,
+        py: Python<'_>,
+        #[pyo3(from_py_with = crate::convert::int_arg::<u32>)] n: u32,
+    ) -> PyResult<()> {
         let (w, dt) = (&mut self.world, self.dt);
         py.detach(|| {
             core(|| {
@@ -256,7 +262,7 @@ impl PyWorld {
         &mut self,
         py: Python<'_>,
         elapsed: f64,
-        max_sub_steps: u32,
+        #[pyo3(from_py_with = crate::convert::int_arg::<u32>)] max_sub_steps: u32,
         fixed_step: Option<f64>,
     ) -> PyResult<u32> {
         let e = scalar("elapsed", elapsed)?;
@@ -284,7 +290,7 @@ impl PyWorld {
     fn poses<'py>(
         &self,
         py: Python<'py>,
-        handles: Option<Vec<u64>>,
+        #[pyo3(from_py_with = crate::convert::opt_u64s_arg)] handles: Option<Vec<u64>>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let hs = self.handles_arg(handles)?;
         let mut rows = Vec::with_capacity(hs.len());
@@ -302,7 +308,7 @@ impl PyWorld {
     fn velocities<'py>(
         &self,
         py: Python<'py>,
-        handles: Option<Vec<u64>>,
+        #[pyo3(from_py_with = crate::convert::opt_u64s_arg)] handles: Option<Vec<u64>>,
     ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
         let hs = self.handles_arg(handles)?;
         let mut lin = Vec::with_capacity(hs.len());
@@ -319,7 +325,11 @@ impl PyWorld {
 
     /// Teleports bodies `handles` to `poses` (`(N, 7)`), waking them. Everything is
     /// checked before any body moves.
-    fn set_poses(&mut self, handles: Vec<u64>, poses: &Bound<'_, PyAny>) -> PyResult<()> {
+    fn set_poses(
+        &mut self,
+        #[pyo3(from_py_with = crate::convert::u64s_arg)] handles: Vec<u64>,
+        poses: &Bound<'_, PyAny>,
+    ) -> PyResult<()> {
         let (ps, _) = extract_poses(Some(poses), "poses")?;
         if ps.len() != handles.len() {
             return Err(invalid(format!(
@@ -344,7 +354,7 @@ impl PyWorld {
     /// Everything is checked before any body changes.
     fn set_velocities(
         &mut self,
-        handles: Vec<u64>,
+        #[pyo3(from_py_with = crate::convert::u64s_arg)] handles: Vec<u64>,
         linear: &Bound<'_, PyAny>,
         angular: &Bound<'_, PyAny>,
     ) -> PyResult<()> {
@@ -371,10 +381,11 @@ impl PyWorld {
     /// Applies an impulse (N·s, world frame) at a world `point` of body `handle`.
     fn apply_impulse(
         &mut self,
-        handle: u64,
+        handle: Int<u64>,
         impulse: &Bound<'_, PyAny>,
         point: &Bound<'_, PyAny>,
     ) -> PyResult<()> {
+        let handle = handle.0;
         let (j, p) = (vec3(impulse, "impulse")?, vec3(point, "point")?);
         core(|| {
             self.world
@@ -388,10 +399,11 @@ impl PyWorld {
     #[pyo3(signature = (handle, force, point = None))]
     fn add_force(
         &mut self,
-        handle: u64,
+        handle: Int<u64>,
         force: &Bound<'_, PyAny>,
         point: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<()> {
+        let handle = handle.0;
         let f = vec3(force, "force")?;
         let p = point.map(|p| vec3(p, "point")).transpose()?;
         let bodies = self.world.bodies_mut();
@@ -403,13 +415,15 @@ impl PyWorld {
     }
 
     /// Adds a torque (N·m, world frame) for the next step; wakes the body.
-    fn add_torque(&mut self, handle: u64, torque: &Bound<'_, PyAny>) -> PyResult<()> {
+    fn add_torque(&mut self, handle: Int<u64>, torque: &Bound<'_, PyAny>) -> PyResult<()> {
+        let handle = handle.0;
         let t = vec3(torque, "torque")?;
         core(|| self.world.bodies_mut().add_torque(self::handle(handle), t))
     }
 
     /// The `user_data` integer body `handle` was created with.
-    fn user_data(&self, handle: u64) -> PyResult<u64> {
+    fn user_data(&self, handle: Int<u64>) -> PyResult<u64> {
+        let handle = handle.0;
         core(|| {
             self.world
                 .bodies()
@@ -419,7 +433,8 @@ impl PyWorld {
     }
 
     /// Whether body `handle` is asleep.
-    fn is_sleeping(&self, handle: u64) -> PyResult<bool> {
+    fn is_sleeping(&self, handle: Int<u64>) -> PyResult<bool> {
+        let handle = handle.0;
         core(|| self.world.bodies().is_sleeping(self::handle(handle)))
     }
 
@@ -469,8 +484,8 @@ impl PyWorld {
     fn add_joint(
         &mut self,
         kind: &str,
-        body_a: u64,
-        body_b: u64,
+        body_a: Int<u64>,
+        body_b: Int<u64>,
         frame_a: Option<&Bound<'_, PyAny>>,
         frame_b: Option<&Bound<'_, PyAny>>,
         limits: Option<(f64, f64)>,
@@ -483,6 +498,8 @@ impl PyWorld {
         break_impulse: f64,
         disable_collisions: bool,
     ) -> PyResult<u64> {
+        let body_a = body_a.0;
+        let body_b = body_b.0;
         let opts = JointOptions {
             frame_a,
             frame_b,
@@ -502,7 +519,8 @@ impl PyWorld {
     }
 
     /// Removes joint `joint` (wakes its bodies).
-    fn remove_joint(&mut self, joint: u64) -> PyResult<()> {
+    fn remove_joint(&mut self, joint: Int<u64>) -> PyResult<()> {
+        let joint = joint.0;
         core(|| self.world.remove_joint(joint_handle(joint)))
     }
 
@@ -517,13 +535,15 @@ impl PyWorld {
     }
 
     /// Whether `joint` is a live joint.
-    fn has_joint(&self, joint: u64) -> bool {
+    fn has_joint(&self, joint: Int<u64>) -> bool {
+        let joint = joint.0;
         self.world.joints().get(joint_handle(joint)).is_ok()
     }
 
     /// Whether `joint` has broken (its impulse exceeded `break_impulse`); a broken joint no
     /// longer acts.
-    fn is_joint_broken(&self, joint: u64) -> PyResult<bool> {
+    fn is_joint_broken(&self, joint: Int<u64>) -> PyResult<bool> {
+        let joint = joint.0;
         core(|| {
             self.world
                 .joints()
@@ -533,7 +553,8 @@ impl PyWorld {
     }
 
     /// The two bodies `(body_a, body_b)` of `joint`.
-    fn joint_bodies(&self, joint: u64) -> PyResult<(u64, u64)> {
+    fn joint_bodies(&self, joint: Int<u64>) -> PyResult<(u64, u64)> {
+        let joint = joint.0;
         let j = core(|| self.world.joints().get(joint_handle(joint)))?;
         Ok((bits(j.desc.body_a), bits(j.desc.body_b)))
     }
@@ -560,7 +581,7 @@ impl PyWorld {
         origins: &Bound<'_, PyAny>,
         directions: &Bound<'_, PyAny>,
         max_distance: f64,
-        mask: u32,
+        #[pyo3(from_py_with = crate::convert::int_arg::<u32>)] mask: u32,
     ) -> PyResult<Option<PyWorldRayHit>> {
         let md = scalar("max_distance", max_distance)?;
         let (o, so) = vec3s(origins, "origins", true)?;
@@ -585,7 +606,7 @@ impl PyWorld {
         pose: &Bound<'_, PyAny>,
         velocity: &Bound<'_, PyAny>,
         max_time: f64,
-        mask: u32,
+        #[pyo3(from_py_with = crate::convert::int_arg::<u32>)] mask: u32,
     ) -> PyResult<Option<PyWorldShapeCastHit>> {
         let s = shape_arg(shape, "shape")?;
         let p = extract_isometry(Some(pose), "pose")?;
@@ -651,8 +672,11 @@ impl PyWorld {
     }
 
     /// Whether `handle` is a live body.
-    fn __contains__(&self, handle: u64) -> bool {
-        self.world.bodies().contains(self::handle(handle))
+    fn __contains__(&self, handle: &Bound<'_, PyAny>) -> bool {
+        // Anything but a handle (a bool, a negative or too large int, another type) is not
+        // in the world.
+        !handle.is_instance_of::<pyo3::types::PyBool>()
+            && matches!(handle.extract::<u64>(), Ok(h) if self.world.bodies().contains(self::handle(h)))
     }
 
     fn __repr__(&self) -> String {
