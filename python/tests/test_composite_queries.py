@@ -92,3 +92,22 @@ def test_cone_rays_normals_far_away_and_plane_casts() -> None:
     plane = carom.Plane([0.0, 1.0, 0.0], 0.0)
     h = carom.shape_cast(carom.Box([0.5, 0.5, 0.5]), carom.Pose([0.0, 2.0, 0.0]), [0.0, -3.0, 0.0], plane, None, [0, 0, 0])
     assert h is not None and abs(h.toi - 0.5) < 1e-6
+
+
+def test_sphere_cast_onto_a_cylinder_ends_with_the_contact_normal() -> None:
+    # The cast stopped within the GJK ray cast's tolerance with its normal 0.24 degrees off
+    # the sphere's radius through the contact point; it now ends with conservative-advancement
+    # steps and the contact query's normal there.
+    a = carom.Sphere(0.8381035327911377)
+    b = carom.Cylinder(1.8616008758544922, 0.9953323602676392)
+    qa = [0.4042821456849178, 0.559846240523436, -0.6263805189340501, -0.3616290629250972]
+    qb = [0.38650358231761744, -0.5191342776828705, 0.24299999485311033, -0.7225410611804157]
+    pa = np.array([-0.7299577838888034, -1.1644746476129855, 0.10823257324411059])
+    pb = np.array([-2.1952375766710857, -5.712924755905853, -1.934490715571448])
+    vb = np.array([3.9690888386835796, 10.125144088187437, 4.806942716191389])
+    h = carom.shape_cast(a, carom.Pose(pa, qa), [0, 0, 0], b, carom.Pose(pb, qb), vb, 0.5)
+    assert h is not None
+    radial = (h.point_a - pa) / np.linalg.norm(h.point_a - pa)
+    assert np.degrees(np.arccos(min(1.0, float(radial @ h.normal)))) < 0.02
+    c = carom.distance(a, carom.Pose(pa, qa), b, carom.Pose(pb + vb * h.toi, qb))
+    assert abs(c.distance) < 1e-5

@@ -44,6 +44,15 @@ fn shape_cast_matches_bisection_on_distance() {
     } else {
         1e-3
     };
+    // Since session 27 the cast ends with conservative-advancement steps to the contact (it
+    // stopped within the GJK ray cast's tolerance, 1e-3 of the size for cylinders and cones,
+    // with their normals 0.2° off): the gap left is the distance query's own accuracy, which
+    // for cylinders and cones near contact in f32 is 1e-4 to 5e-4 (GJK on their rims).
+    let tol_d = if std::mem::size_of::<Real>() == 8 {
+        1e-7
+    } else {
+        5e-4
+    };
     let (mut hits, mut misses) = (0, 0);
     for a in &all {
         for b in &all {
@@ -85,7 +94,17 @@ fn shape_cast_matches_bisection_on_distance() {
                             h.toi
                         );
                         assert!((h.normal.length() - 1.0).abs() < 1e-3);
-                        // Touching at toi: witnesses coincide.
+                        // Touching at toi: the distance there is within the distance
+                        // query's own accuracy of zero, and the witnesses coincide.
+                        let moved = Isometry::new(pb.translation + (vb - va) * h.toi, pb.rotation);
+                        let at_a = Isometry::new(pa.translation, pa.rotation);
+                        let c = distance(a, &at_a, b, &moved).unwrap();
+                        assert!(
+                            c.distance.abs() < tol_d,
+                            "{} {}: {c:?} vs {h:?}",
+                            a.kind_name(),
+                            b.kind_name()
+                        );
                         assert!(
                             (h.point_a - h.point_b).length() < 1e-3,
                             "{} {}: {h:?} {t}",
