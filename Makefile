@@ -1,6 +1,6 @@
 # Carom: the two commands of the README, and the pieces they are made of.
 #   make demo   build and run a real example
-#   make test   every check CI runs (fmt, clippy, cargo test f32 + f64 + serial, Python package + pytest)
+#   make test   every check CI runs (fmt, clippy, rustdoc, cargo test f32 + f64 + serial, Python package + pytest)
 #   make bench  Bullet's benchmark scenes: Carom, Rapier and Bullet (pybullet) side by side
 # Everything Python lives in a local venv (.venv) that these targets create.
 
@@ -53,6 +53,9 @@ lint: toolchain
 	# The serial build (no `parallel` feature) has cfg paths of its own (library code; its
 	# unit tests run in rust-test-serial).
 	$(CARGO) clippy -p carom-collision -p carom-dynamics --no-default-features --lib -- -D warnings
+	# Rustdoc of the library crates: broken or private intra-doc links fail (session 27 found
+	# one that had stood since session 25).
+	RUSTDOCFLAGS="-D warnings" $(CARGO) doc --no-deps -p carom-collision -p carom-dynamics -p carom-scenes
 
 rust-test: toolchain
 	$(CARGO) test --workspace

@@ -56,7 +56,7 @@ impl World {
     ///
     /// With [`crate::WorldParams::parallel`], [`super::PipelineParams::spin_workers`] and
     /// more than one thread in the current rayon pool, the pool's other threads are kept
-    /// awake for the length of the step ([`with_workers_awake`]).
+    /// awake for the length of the step (`with_workers_awake`).
     pub fn step(&mut self, dt: Real) -> Result<&PipelineReport> {
         let dt = Self::check_dt("dt", dt)?;
         let spin = self.params.dynamics.parallel && self.params.spin_workers;
