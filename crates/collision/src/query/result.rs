@@ -105,6 +105,20 @@ pub struct ShapeCastHit {
     pub initially_overlapping: bool,
 }
 
+impl ShapeCastHit {
+    /// The hit at time `toi` whose witnesses and normal are those of the contact `c` at that
+    /// time (the contact query that ends a cast or an advancement).
+    pub fn at_contact(toi: Real, c: &Contact, initially_overlapping: bool) -> Self {
+        ShapeCastHit {
+            toi,
+            point_a: c.point_a,
+            point_b: c.point_b,
+            normal: c.normal,
+            initially_overlapping,
+        }
+    }
+}
+
 /// Projection of a point on a shape's surface.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct PointProjection {

@@ -193,13 +193,7 @@ pub fn shape_cast_convex(
     let hit = gjk_raycast(&diff, ra + rb, Vec3::ZERO, rel_vel, max_toi)?;
     if hit.inside {
         let c: Contact = contact_convex(a, b, pose_ab, Real::INFINITY)?;
-        return Some(ShapeCastHit {
-            toi: 0.0,
-            point_a: c.point_a,
-            point_b: c.point_b,
-            normal: c.normal,
-            initially_overlapping: c.distance < 0.0,
-        });
+        return Some(ShapeCastHit::at_contact(0.0, &c, c.distance < 0.0));
     }
     // The ray normal is the outward normal of A - B at the hit. As for distances (the
     // normal from A to B is minus the direction of the closest point of A - B, i.e. the
@@ -263,11 +257,5 @@ fn refine_cast(
     if c.distance < -tol || !unit {
         return Some(cast);
     }
-    Some(ShapeCastHit {
-        toi: t,
-        point_a: c.point_a,
-        point_b: c.point_b,
-        normal: c.normal,
-        initially_overlapping: false,
-    })
+    Some(ShapeCastHit::at_contact(t, &c, false))
 }

@@ -312,13 +312,8 @@ fn conservative_advancement(
         };
         let c = c.transformed(&pa);
         if c.distance <= tolerance {
-            return Ok(Some(ShapeCastHit {
-                toi: t,
-                point_a: c.point_a,
-                point_b: c.point_b,
-                normal: c.normal,
-                initially_overlapping: t == 0.0 && c.distance < 0.0,
-            }));
+            let overlapping = t == 0.0 && c.distance < 0.0;
+            return Ok(Some(ShapeCastHit::at_contact(t, &c, overlapping)));
         }
         let bound = (motion_a.linvel - motion_b.linvel).dot(c.normal) + spin;
         if bound <= 0.0 {
@@ -332,16 +327,6 @@ fn conservative_advancement(
     // Cap reached: report the last safe time.
     let (pa, pb) = pose_at(t);
     let pose_ab = pa.inv_mul(&pb);
-    Ok(
-        contact_local(a.shape, b.shape, &pose_ab, Real::INFINITY)?.map(|c| {
-            let c = c.transformed(&pa);
-            ShapeCastHit {
-                toi: t,
-                point_a: c.point_a,
-                point_b: c.point_b,
-                normal: c.normal,
-                initially_overlapping: false,
-            }
-        }),
-    )
+    Ok(contact_local(a.shape, b.shape, &pose_ab, Real::INFINITY)?
+        .map(|c| ShapeCastHit::at_contact(t, &c.transformed(&pa), false)))
 }
